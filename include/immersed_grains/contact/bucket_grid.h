@@ -1,0 +1,114 @@
+#ifndef immersed_grains_contact_bucket_grid_h
+#define immersed_grains_contact_bucket_grid_h
+
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <array>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  namespace Contact
+  {
+    using dealii::Point;
+    using dealii::Tensor;
+
+    /**
+     * A candidate grain-grain contact: two grains whose gap is below the
+     * alert distance at the start of the step.
+     */
+    template <int dim>
+    struct GrainPair
+    {
+      /// Grain indices, first < second.
+      unsigned int first;
+      unsigned int second;
+
+      /// Unit normal from the centre of @p first to the centre of the image
+      /// of @p second that is nearest to it.
+      Tensor<1, dim> normal;
+
+      /// Centre distance minus both radii (negative: overlap), in metres.
+      double gap;
+
+      /// Periodic image used: x[second] + shift is the centre seen by
+      /// @p first. Zero unless the pair touches across a periodic face.
+      Tensor<1, dim> shift;
+    };
+
+    /**
+     * Uniform bucket grid ("cell list") for the grain-grain neighbour search,
+     * independent of any finite element mesh: O(N) for a bounded number of
+     * grains per bucket.
+     *
+     * The bucket edge is at least the largest diameter plus the alert
+     * distance, so every pair closer than the alert distance lies in the same
+     * or in adjacent buckets. Grains outside the box on a non-periodic axis
+     * are clamped into the outermost bucket layer, which keeps the search
+     * correct (only slower) for grains that escaped through a wall. On a
+     * periodic axis positions are wrapped and pairs use the nearest image;
+     * that axis must be at least two bucket edges long, so that no grain can
+     * see two images of the same neighbour.
+     *
+     * The object keeps its work arrays between calls, so that a time loop
+     * does not allocate once the grain count is steady.
+     */
+    template <int dim>
+    class BucketGrid
+    {
+    public:
+      /**
+       * The box [lower, upper] in which the grains live (positions outside
+       * it are allowed on non-periodic axes) and which axes are periodic.
+       */
+      BucketGrid(const Point<dim>            &lower,
+                 const Point<dim>            &upper,
+                 const std::array<bool, dim> &periodic = {});
+
+      /**
+       * Fills @p pairs with every pair (i < j) with
+       * |x_j - x_i| - r_i - r_j < alert_distance, sorted by (i, j).
+       */
+      void
+      find_pairs(const std::vector<Point<dim>> &positions,
+                 const std::vector<double>     &radii,
+                 const double                   alert_distance,
+                 std::vector<GrainPair<dim>>   &pairs);
+
+      /// Number of buckets per axis chosen by the last find_pairs() call.
+      const std::array<unsigned int, dim> &
+      n_buckets() const;
+
+    private:
+      Point<dim>            lower;
+      Tensor<1, dim>        extent;
+      std::array<bool, dim> periodic;
+
+      std::array<unsigned int, dim> n_buckets_per_axis;
+      Tensor<1, dim>                bucket_size;
+
+      // Work arrays, grains sorted by bucket (counting sort).
+      std::vector<unsigned int> bucket_of_grain;
+      std::vector<unsigned int> bucket_start;
+      std::vector<unsigned int> grain_in_order;
+      std::vector<Point<dim>>   wrapped_position;
+      std::vector<std::array<int, dim>> wrap_count;
+      std::vector<unsigned int>         sort_buffer;
+      std::vector<unsigned int>         sort_count;
+      std::vector<GrainPair<dim>>       unsorted_pairs;
+
+      void
+      choose_buckets(const unsigned int n_grains, const double min_size);
+
+      void
+      sort_grains_into_buckets(const std::vector<Point<dim>> &positions);
+
+      void
+      sort_pairs_by_index(const unsigned int           n_grains,
+                          std::vector<GrainPair<dim>> &pairs);
+    };
+  } // namespace Contact
+} // namespace ImmersedGrains
+
+#endif

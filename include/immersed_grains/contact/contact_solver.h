@@ -1,0 +1,297 @@
+#ifndef immersed_grains_contact_contact_solver_h
+#define immersed_grains_contact_contact_solver_h
+
+#include <deal.II/base/tensor.h>
+
+#include <immersed_grains/contact/bucket_grid.h>
+#include <immersed_grains/contact/walls.h>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  namespace Contact
+  {
+    using dealii::Tensor;
+
+    /// Angular velocity: its out-of-plane component in 2D, a vector in 3D.
+    template <int dim>
+    using AngularVelocity = Tensor<1, (dim == 2 ? 1 : 3)>;
+
+    /**
+     * The per-grain arrays of one time step, gathered once from wherever the
+     * grains live (ParticleHandler, a test, a ghost exchange). Index i is the
+     * same grain in every array and in GrainPair/WallContact.
+     */
+    template <int dim>
+    struct GrainArrays
+    {
+      /// In: free velocity v + dt F / m_eff. Out (ContactSolver::finish()):
+      /// end-of-step velocity.
+      std::vector<Tensor<1, dim>> velocity;
+
+      /// Same for the angular velocity; read only when friction > 0.
+      std::vector<AngularVelocity<dim>> angular_velocity;
+
+      /// Velocity at the start of the step, the pre-impact velocity of
+      /// Newton's law. Read only when restitution > 0; if empty, the free
+      /// velocity stands in for it.
+      std::vector<Tensor<1, dim>> start_velocity;
+
+      /// 1 / m_eff, with m_eff = m + dt beta under implicit drag; 0 for a
+      /// fixed grain.
+      std::vector<double> inverse_mass;
+
+      /// 1 / I_eff; read only when friction > 0 (0: no rotation).
+      std::vector<double> inverse_inertia;
+
+      std::vector<double> radius;
+
+      /// Persistent grain ids (e.g. particle ids), so that warm starting
+      /// survives reordering. If empty, the index is the id.
+      std::vector<std::uint64_t> id;
+    };
+
+    struct ContactParameters
+    {
+      /// Newton coefficient of restitution e in [0, 1].
+      double restitution = 0;
+
+      /// Coulomb friction coefficient mu >= 0; 0 switches rotation off.
+      double friction = 0;
+
+      /// Converged when no impulse changed by more than this times the
+      /// largest impulse during the last sweep ...
+      double tolerance = 1e-6;
+
+      /// ... and the largest overlap predicted for the end of the step is
+      /// below this times the smallest radius in contact.
+      double overlap_tolerance = 1e-3;
+
+      unsigned int max_iterations = 1000;
+
+      /// Start from last step's impulses, matched by grain ids.
+      bool warm_start = true;
+    };
+
+    /// Local measures of one Gauss-Seidel sweep (reduce with max over ranks).
+    struct SweepResult
+    {
+      double max_change  = 0;
+      double max_impulse = 0;
+    };
+
+    struct SolverResult
+    {
+      unsigned int iterations = 0;
+      bool         converged  = false;
+      /// max_change / max_impulse of the last sweep.
+      double residual = 0;
+      /// Largest overlap predicted for the end of the step, in metres.
+      double       max_overlap = 0;
+      unsigned int n_contacts  = 0;
+      /// Contacts that carry a non-zero normal impulse.
+      unsigned int n_active = 0;
+    };
+
+    /// Impulses per contact, in the order of the contact list given.
+    template <int dim>
+    struct ContactImpulses
+    {
+      /// Normal impulse p_n >= 0 (force = p_n / dt), pushing the partner
+      /// along +normal and the grain along -normal.
+      std::vector<double> normal;
+      /// Tangential impulse on the partner (zero without friction).
+      std::vector<Tensor<1, dim>> tangential;
+    };
+
+    /**
+     * Moreau-Jean non-smooth contact dynamics for rigid discs (dim = 2) and
+     * spheres (dim = 3), solved by projected Gauss-Seidel over the contacts
+     * (Moreau 1988; Jean 1999). The formulas, with their derivation, are in
+     * contact_solver.cc and doc/contacts.md.
+     *
+     * One step: setup() packs the contacts and grains into contiguous work
+     * arrays and warm-starts; sweep() visits every contact once; converged()
+     * tests a sweep; finish() writes the velocities back. solve() strings
+     * them together. They are separate so that a distributed caller can put
+     * its own communication between sweeps:
+     *  - each rank lists the contacts it owns and appends ghost grains
+     *    (owned elsewhere, touching its own) to GrainArrays;
+     *  - after each sweep(), a rank sends the velocity change it has put on
+     *    each ghost grain to that grain's owner, which adds the changes up
+     *    and returns the new velocity to every rank holding the ghost
+     *    (get_velocity()/set_velocity() and the angular versions give the
+     *    working velocities);
+     *  - SweepResult and predicted_max_overlap() are reduced with max over
+     *    all ranks before converged() decides, so all ranks stop together.
+     */
+    template <int dim>
+    class ContactSolver
+    {
+    public:
+      explicit ContactSolver(
+        const ContactParameters &parameters = ContactParameters());
+
+      void
+      set_parameters(const ContactParameters &parameters);
+
+      const ContactParameters &
+      get_parameters() const;
+
+      /**
+       * One contact step: grains.velocity (and angular_velocity) go in as
+       * free velocities and come out as end-of-step velocities. The
+       * impulses are then available from pair_impulses()/wall_impulses().
+       * Not converging within max_iterations is reported in the result,
+       * never hidden: the caller decides whether to go on.
+       */
+      SolverResult
+      solve(const std::vector<GrainPair<dim>>   &pairs,
+            const std::vector<WallContact<dim>> &wall_contacts,
+            const std::vector<Tensor<1, dim>>   &wall_velocities,
+            GrainArrays<dim>                    &grains,
+            const double                         time_step);
+
+      /**
+       * Packs one step's problem. @p wall_velocities is indexed by
+       * WallContact::wall (Walls::velocities()).
+       */
+      void
+      setup(const std::vector<GrainPair<dim>>   &pairs,
+            const std::vector<WallContact<dim>> &wall_contacts,
+            const std::vector<Tensor<1, dim>>   &wall_velocities,
+            const GrainArrays<dim>              &grains,
+            const double                         time_step);
+
+      /// One projected Gauss-Seidel pass over all contacts; passes alternate
+      /// between forward and backward order.
+      SweepResult
+      sweep();
+
+      /// Largest -(g + dt u_n) over the contacts, with the current
+      /// velocities: the overlap the position update would leave.
+      double
+      predicted_max_overlap() const;
+
+      /// The overlap converged() accepts, in metres.
+      double
+      overlap_limit() const;
+
+      bool
+      converged(const SweepResult &sweep, const double max_overlap) const;
+
+      /// Writes the working velocities into @p grains, fills the impulse
+      /// lists and keeps the impulses for the next warm start.
+      void
+      finish(GrainArrays<dim> &grains);
+
+      const ContactImpulses<dim> &
+      pair_impulses() const;
+
+      const ContactImpulses<dim> &
+      wall_impulses() const;
+
+      /// Working velocities between setup() and finish().
+      Tensor<1, dim>
+      get_velocity(const unsigned int grain) const;
+
+      void
+      set_velocity(const unsigned int grain, const Tensor<1, dim> &velocity);
+
+      AngularVelocity<dim>
+      get_angular_velocity(const unsigned int grain) const;
+
+      void
+      set_angular_velocity(const unsigned int          grain,
+                           const AngularVelocity<dim> &angular_velocity);
+
+    private:
+      static constexpr unsigned int spin_dim = (dim == 2 ? 1 : 3);
+
+      // Work arrays laid out for the sweep: what one contact update reads
+      // sits together, what only friction needs sits apart.
+      struct GrainSlot
+      {
+        double velocity[dim];
+        double inverse_mass;
+      };
+
+      struct SpinSlot
+      {
+        double angular_velocity[spin_dim];
+        double inverse_inertia;
+      };
+
+      struct Row
+      {
+        unsigned int i; // grain
+        unsigned int j; // partner: a grain, or a wall slot after the grains
+        double       normal[dim];
+        double       target;    // lower bound of u_n after the step
+        double       inverse_w; // 1 / (normal Delassus entry)
+        double       p_n;
+      };
+
+      struct FrictionRow
+      {
+        double p_t[dim];
+        double inverse_w_t; // 1 / (tangential Delassus entry)
+        double radius_i;
+        double radius_j;
+      };
+
+      using Key = std::pair<std::uint64_t, std::uint64_t>;
+
+      struct CachedImpulse
+      {
+        Key            key;
+        double         p_n;
+        Tensor<1, dim> p_t;
+      };
+
+      ContactParameters parameters;
+      double            dt;
+      unsigned int      n_grains;
+      unsigned int      n_pairs;
+      bool              forward;
+      double            smallest_radius;
+
+      std::vector<GrainSlot>   grains;
+      std::vector<SpinSlot>    spins;
+      std::vector<Row>         rows;
+      std::vector<FrictionRow> friction_rows;
+      std::vector<double>      gaps;
+      std::vector<Key>         keys;     // warm-start key of each row
+      std::vector<double>      key_sign; // -1 where the key swapped the pair
+
+      std::vector<CachedImpulse> cache;
+
+      ContactImpulses<dim> pair_results;
+      ContactImpulses<dim> wall_results;
+
+      void
+      add_row(const unsigned int      i,
+              const unsigned int      j,
+              const Tensor<1, dim>   &normal,
+              const double            gap,
+              const GrainArrays<dim> &grain_arrays);
+
+      void
+      warm_start();
+
+      void
+      apply_impulse(const unsigned int    k,
+                    const double          dp_n,
+                    const double         *dp_t);
+
+      template <bool with_friction>
+      SweepResult
+      sweep_rows();
+    };
+  } // namespace Contact
+} // namespace ImmersedGrains
+
+#endif

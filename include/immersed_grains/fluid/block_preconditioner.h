@@ -1,0 +1,67 @@
+#ifndef immersed_grains_fluid_block_preconditioner_h
+#define immersed_grains_fluid_block_preconditioner_h
+
+#include <deal.II/lac/trilinos_block_sparse_matrix.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/trilinos_precondition.h>
+
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /**
+   * Upper block-triangular preconditioner for the saddle point system
+   *
+   *   [ A  B^T ] [u]   [f]        P = [ A  B^T ]
+   *   [ B  0   ] [p] = [g],           [ 0  -S  ],
+   *
+   * applied as p = -S~^{-1} g, u = A~^{-1}(f - B^T p). A~^{-1} is one or
+   * more AMG V-cycles on the velocity block. S~^{-1} is the Cahouet-Chabard
+   * sum M_w^{-1} + L_k^{-1} of a pressure mass matrix weighted by phi/mu
+   * (the viscous limit of S) and a pressure Laplacian weighted by
+   * phi^2/(phi rho a0/dt + beta) (the mass- and drag-dominated limit), each
+   * approximated by one application of ILU (mass) or AMG (Laplacian); either
+   * term may be left out. doc/theory.md motivates the weights.
+   */
+  class BlockSchurPreconditioner
+  {
+  public:
+    using VectorType = dealii::TrilinosWrappers::MPI::BlockVector;
+
+    struct Settings
+    {
+      unsigned int velocity_cycles = 1;
+      // Constant modes of the velocity components (near null space of A).
+      std::vector<std::vector<bool>> velocity_constant_modes;
+    };
+
+    /**
+     * @p pressure_mass or @p pressure_laplace may be null to leave that
+     * term out of S~^{-1}.
+     */
+    BlockSchurPreconditioner(
+      const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
+      const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass,
+      const dealii::TrilinosWrappers::SparseMatrix      *pressure_laplace,
+      const Settings                                    &settings);
+
+    void
+    vmult(VectorType &dst, const VectorType &src) const;
+
+  private:
+    const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
+    const unsigned int                                 velocity_cycles;
+
+    dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
+    dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;
+    dealii::TrilinosWrappers::PreconditionAMG pressure_laplace_amg;
+    bool                                      use_mass    = false;
+    bool                                      use_laplace = false;
+
+    mutable dealii::TrilinosWrappers::MPI::Vector velocity_tmp;
+    mutable dealii::TrilinosWrappers::MPI::Vector velocity_residual;
+    mutable dealii::TrilinosWrappers::MPI::Vector pressure_tmp;
+  };
+} // namespace ImmersedGrains
+
+#endif

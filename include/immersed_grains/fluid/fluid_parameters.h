@@ -1,0 +1,65 @@
+#ifndef immersed_grains_fluid_fluid_parameters_h
+#define immersed_grains_fluid_fluid_parameters_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/parsed_function.h>
+
+#include <immersed_grains/mesh/geometry.h>
+
+#include <memory>
+#include <string>
+
+namespace ImmersedGrains
+{
+  /** Which approximation of the Schur complement S = B A^{-1} B^T. */
+  enum class SchurApproximation
+  {
+    cahouet_chabard, // S^{-1} ~ M_{phi/mu}^{-1} + L_{phi^2/c}^{-1}
+    pressure_mass,   // viscous limit only
+    pressure_laplace // mass/drag limit only
+  };
+
+  /**
+   * Everything in `subsection Fluid`. The prescribed fields (fluid
+   * fraction, drag coefficient, grain velocity) describe the mixture when
+   * no grains are simulated; with grains they come from the projection.
+   */
+  template <int dim>
+  struct FluidParameters
+  {
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    void
+    parse_parameters(dealii::ParameterHandler &prm,
+                     const std::string        &file,
+                     const Geometry<dim>      &geometry);
+
+    bool         enabled                  = true;
+    double       density                  = 1.0;
+    double       viscosity                = 1.0;
+    bool         advection                = true;
+    bool         time_derivative          = true;
+    unsigned int bdf_order                = 2;
+    bool         newton                   = false;
+    double       nonlinear_tolerance      = 1e-8;
+    unsigned int max_nonlinear_iterations = 20;
+
+    bool               direct_solver          = false;
+    double             linear_tolerance       = 1e-8;
+    unsigned int       max_linear_iterations  = 500;
+    SchurApproximation schur_approximation    = SchurApproximation::cahouet_chabard;
+    unsigned int       velocity_amg_cycles    = 1;
+
+    // Prescribed fields; shared so that a test can substitute exact ones.
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> fluid_fraction;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> drag_coefficient;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> grain_velocity;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> forcing;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> boundary_velocity;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> open_boundary_pressure;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> initial_velocity;
+  };
+} // namespace ImmersedGrains
+
+#endif

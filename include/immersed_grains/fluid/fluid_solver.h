@@ -1,0 +1,179 @@
+#ifndef immersed_grains_fluid_fluid_solver_h
+#define immersed_grains_fluid_fluid_solver_h
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/function.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_block_sparse_matrix.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/numerics/data_out.h>
+
+#include <immersed_grains/fluid/fluid_parameters.h>
+#include <immersed_grains/fluid/mixture_fields.h>
+#include <immersed_grains/mesh/geometry.h>
+
+#include <memory>
+
+namespace ImmersedGrains
+{
+  class BlockSchurPreconditioner;
+
+  /**
+   * The volume-averaged (VANS) fluid: interstitial velocity u and pressure p
+   * (minus its hydrostatic part) on Taylor-Hood Q2-Q1, solving
+   *
+   *   phi rho (du/dt + u.grad u) - div(phi mu grad u) + phi grad p
+   *                                          + beta (u - u_p) = f,
+   *   div(phi u) + div((1 - phi) u_p) = 0,
+   *
+   * with the mixture fields (phi, beta, u_p) supplied by a MixtureFields
+   * object (doc/theory.md derives the weak form). Files:
+   * fluid_solver.cc (set-up, boundary conditions, output, errors),
+   * fluid_assembly.cc (one cell loop: matrix, residual, preconditioner
+   * matrices), fluid_linear_solver.cc (FGMRES + block preconditioner).
+   */
+  template <int dim>
+  class FluidSolver
+  {
+  public:
+    using VectorType = dealii::TrilinosWrappers::MPI::BlockVector;
+    using MatrixType = dealii::TrilinosWrappers::BlockSparseMatrix;
+
+    FluidSolver(const FluidParameters<dim>                        &parameters,
+                const Geometry<dim>                               &geometry,
+                dealii::parallel::distributed::Triangulation<dim> &triangulation,
+                dealii::TimerOutput                               &timer,
+                dealii::ConditionalOStream                        &pcout);
+    ~FluidSolver();
+
+    /** Distributes DoFs, builds constraints and sparsity. */
+    void
+    setup_dofs();
+
+    /** Sets u from Fluid/Initial velocity, p = 0. */
+    void
+    set_initial_condition();
+
+    void
+    set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields);
+
+    /** Replaces the forcing and boundary data (tests with exact solutions). */
+    void
+    set_forcing(std::shared_ptr<dealii::Function<dim>> forcing);
+    void
+    set_boundary_velocity(std::shared_ptr<dealii::Function<dim>> velocity);
+
+    struct StepStatistics
+    {
+      unsigned int nonlinear_iterations = 0;
+      unsigned int linear_iterations    = 0; // summed over nonlinear steps
+      double       initial_residual     = 0;
+      double       final_residual       = 0;
+    };
+
+    /** Advances from the current time to @p new_time = time + dt. */
+    StepStatistics
+    solve_time_step(double new_time, double dt);
+
+    /** L2 velocity, H1-semi velocity, L2 pressure (both mean-free) errors. */
+    std::array<double, 3>
+    compute_errors(const dealii::Function<dim> &exact_solution) const;
+
+    /** Adds velocity, pressure, fluid fraction, beta to @p data_out. */
+    void
+    add_data_vectors(dealii::DataOut<dim> &data_out) const;
+
+    /** Integral of the fluid fraction over the mesh. */
+    double
+    integrate_fluid_fraction() const;
+
+    dealii::types::global_dof_index
+    n_dofs() const;
+
+    const dealii::DoFHandler<dim> &
+    get_dof_handler() const;
+
+    const VectorType &
+    get_solution() const;
+
+    double
+    get_time() const;
+
+  private:
+    void
+    make_constraints();
+
+    void
+    assemble_system(bool assemble_preconditioner_matrices);
+
+    unsigned int
+    solve_linear_system();
+
+    void
+    build_preconditioner();
+
+    void
+    normalize_pressure(VectorType &vector) const;
+
+    bool
+    pressure_has_null_space() const;
+
+    const FluidParameters<dim> &parameters;
+    const Geometry<dim>        &geometry;
+    dealii::parallel::distributed::Triangulation<dim> &triangulation;
+    dealii::TimerOutput                               &timer;
+    dealii::ConditionalOStream                        &pcout;
+    MPI_Comm                                           mpi_communicator;
+
+    dealii::FESystem<dim>     fe;
+    dealii::DoFHandler<dim>   dof_handler;
+    dealii::MappingQ1<dim>    mapping;
+    std::vector<dealii::IndexSet> owned_partitioning;
+    std::vector<dealii::IndexSet> relevant_partitioning;
+
+    // Constraints of the solution (inhomogeneous Dirichlet data) and of the
+    // Newton/Picard update (homogeneous), and those of the pressure Laplacian
+    // of the Schur preconditioner (pressure fixed on open faces).
+    dealii::AffineConstraints<double> solution_constraints;
+    dealii::AffineConstraints<double> update_constraints;
+    dealii::AffineConstraints<double> pressure_mass_constraints;
+    dealii::AffineConstraints<double> pressure_laplace_constraints;
+
+    MatrixType system_matrix;
+    MatrixType pressure_mass_matrix;    // block (1,1) used
+    MatrixType pressure_laplace_matrix; // block (1,1) used
+
+    VectorType solution;           // ghosted, current iterate / new time
+    VectorType old_solution;       // ghosted, t^n
+    VectorType old_old_solution;   // ghosted, t^{n-1}
+    VectorType system_rhs;         // owned: minus the residual
+    VectorType newton_update;      // owned
+
+    std::shared_ptr<const MixtureFields<dim>> mixture_fields;
+    std::shared_ptr<dealii::Function<dim>>    forcing;
+    std::shared_ptr<dealii::Function<dim>>    boundary_velocity;
+
+    double       time          = 0;
+    double       dt            = 0;
+    double       old_dt        = 0;
+    unsigned int steps_done    = 0;
+    // BDF coefficients of u^{n+1}, u^n, u^{n-1} (divided by dt when used).
+    std::array<double, 3> bdf = {{0, 0, 0}};
+
+    std::unique_ptr<BlockSchurPreconditioner> preconditioner;
+    // Largest weight of the pressure Laplacian; zero when neither inertia
+    // nor drag is present (steady Stokes), and the term is then left out.
+    double schur_laplace_weight = 0;
+
+    // DataOut keeps a pointer to the postprocessor until patches are built.
+    mutable std::unique_ptr<dealii::DataPostprocessor<dim>> output_fields;
+  };
+} // namespace ImmersedGrains
+
+#endif

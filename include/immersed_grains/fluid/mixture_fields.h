@@ -1,0 +1,83 @@
+#ifndef immersed_grains_fluid_mixture_fields_h
+#define immersed_grains_fluid_mixture_fields_h
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+#include <deal.II/grid/tria.h>
+
+#include <memory>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /**
+   * What the fluid sees of the grains at the quadrature points of one cell:
+   * fluid fraction phi and its gradient, a continuous drag coefficient beta,
+   * the grain velocity u_p, and the divergence of the solid volume flux
+   * (1 - phi) u_p that enters the mixture continuity equation.
+   */
+  template <int dim>
+  struct MixtureValues
+  {
+    void
+    resize(unsigned int n);
+
+    std::vector<double>                 fluid_fraction;
+    std::vector<dealii::Tensor<1, dim>> fluid_fraction_gradient;
+    std::vector<double>                 drag_coefficient;
+    std::vector<dealii::Tensor<1, dim>> grain_velocity;
+    std::vector<double>                 solid_flux_divergence;
+    std::vector<double>                 mass_source;
+  };
+
+
+  /**
+   * The source of MixtureValues. Prescribed fields (functions in the .prm,
+   * or exact solutions in a test) and the fields projected from grains are
+   * two implementations; the fluid solver does not know which it has.
+   */
+  template <int dim>
+  class MixtureFields
+  {
+  public:
+    virtual ~MixtureFields() = default;
+
+    virtual void
+    evaluate(const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+             const std::vector<dealii::Point<dim>> &points,
+             double                                 time,
+             MixtureValues<dim>                    &values) const = 0;
+  };
+
+
+  /**
+   * Mixture fields given as functions of space and time. The gradient of
+   * the fluid fraction and the divergence of the grain velocity come from
+   * the functions' gradient(), so exact functions give exact coefficients.
+   */
+  template <int dim>
+  class PrescribedMixtureFields : public MixtureFields<dim>
+  {
+  public:
+    PrescribedMixtureFields(
+      std::shared_ptr<dealii::Function<dim>> fluid_fraction,
+      std::shared_ptr<dealii::Function<dim>> drag_coefficient,
+      std::shared_ptr<dealii::Function<dim>> grain_velocity,
+      std::shared_ptr<dealii::Function<dim>> mass_source = nullptr);
+
+    void
+    evaluate(const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+             const std::vector<dealii::Point<dim>> &points,
+             double                                 time,
+             MixtureValues<dim>                    &values) const override;
+
+  private:
+    std::shared_ptr<dealii::Function<dim>> fluid_fraction;
+    std::shared_ptr<dealii::Function<dim>> drag_coefficient;
+    std::shared_ptr<dealii::Function<dim>> grain_velocity;
+    std::shared_ptr<dealii::Function<dim>> mass_source;
+  };
+} // namespace ImmersedGrains
+
+#endif

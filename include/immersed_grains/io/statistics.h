@@ -1,0 +1,54 @@
+#ifndef immersed_grains_io_statistics_h
+#define immersed_grains_io_statistics_h
+
+#include <fstream>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /**
+   * The per-step table written to statistics.csv: a fixed column order set
+   * once (the interface contract of DESIGN.md first), one row per call to
+   * write_row(). Only rank 0 writes; the row is flushed at once so that a
+   * run that stops early still leaves its history.
+   */
+  class Statistics
+  {
+  public:
+    explicit Statistics(std::vector<std::string> columns);
+
+    /** Opens DIR/statistics.csv and writes the header (rank 0 only). */
+    void
+    open(const std::string &file_name, bool is_root);
+
+    void
+    set(const std::string &column, double value);
+
+    double
+    get(const std::string &column) const;
+
+    bool
+    has(const std::string &column) const;
+
+    /** Writes the current values as one row and keeps them. */
+    void
+    write_row();
+
+    /** Prints the chosen columns of the current row (test mode). */
+    void
+    print(std::ostream &out, const std::vector<std::string> &columns) const;
+
+    const std::vector<std::string> &
+    column_names() const;
+
+  private:
+    std::vector<std::string>      columns;
+    std::map<std::string, double> values;
+    std::ofstream                 file;
+  };
+} // namespace ImmersedGrains
+
+#endif

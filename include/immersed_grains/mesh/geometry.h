@@ -1,0 +1,61 @@
+#ifndef immersed_grains_mesh_geometry_h
+#define immersed_grains_mesh_geometry_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/distributed/tria.h>
+
+#include <immersed_grains/parameters.h>
+
+#include <string>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /** What happens to fluid and grains at one face of the box. */
+  enum class BoundaryType
+  {
+    wall,     // no-slip for the fluid, a wall for grains
+    slip,     // no normal flow, free tangential flow; a wall for grains
+    open,     // traction (prescribed pressure) for the fluid; grains leave
+    velocity, // prescribed fluid velocity (Fluid/Boundary velocity); a wall
+    periodic  // paired with the opposite face
+  };
+
+  std::string
+  to_string(BoundaryType type);
+
+  /**
+   * The box domain, its subdivisions and the boundary condition of each
+   * face. Boundary id i is face i in deal.II's numbering: 0 = x-min,
+   * 1 = x-max, 2 = y-min, 3 = y-max, 4 = z-min, 5 = z-max.
+   */
+  template <int dim>
+  class Geometry
+  {
+  public:
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    void
+    parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
+
+    /** Builds the coarse mesh, sets periodicity, refines globally. */
+    void
+    create_mesh(dealii::parallel::distributed::Triangulation<dim> &tria) const;
+
+    bool
+    is_periodic(unsigned int direction) const;
+
+    bool
+    has_open_boundary() const;
+
+    dealii::Point<dim>        lower_corner;
+    dealii::Point<dim>        upper_corner;
+    std::vector<unsigned int> subdivisions;
+    unsigned int              initial_refinement = 0;
+    std::vector<BoundaryType> boundary_types; // one per face
+  };
+} // namespace ImmersedGrains
+
+#endif

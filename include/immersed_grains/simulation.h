@@ -1,0 +1,86 @@
+#ifndef immersed_grains_simulation_h
+#define immersed_grains_simulation_h
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/distributed/tria.h>
+
+#include <immersed_grains/fluid/fluid_parameters.h>
+#include <immersed_grains/io/run_log.h>
+#include <immersed_grains/io/statistics.h>
+#include <immersed_grains/mesh/geometry.h>
+
+#include <memory>
+#include <string>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  class FluidSolver;
+  template <int dim>
+  class FieldOutput;
+
+  /**
+   * One run of a scene: owns the mesh, the fluid solver, the grains and the
+   * output, and strings them together in run(). It holds no physics of its
+   * own.
+   */
+  template <int dim>
+  class Simulation
+  {
+  public:
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /** Parses everything; throws InputError before anything is written. */
+    Simulation(dealii::ParameterHandler &prm,
+               const std::string        &parameter_file,
+               MPI_Comm                  comm);
+    ~Simulation();
+
+    void
+    run();
+
+  private:
+    void
+    prepare_output_directory();
+    void
+    setup();
+    void
+    solve_time_step(double dt);
+    void
+    postprocess(double dt, unsigned int fluid_iterations);
+    void
+    maybe_write_fields(bool force);
+
+    MPI_Comm    comm;
+    std::string parameter_file;
+    std::string output_directory;
+    double      end_time  = 1;
+    double      time_step = 1;
+
+    unsigned int             write_fields_every = 0;
+    bool                     test_output        = false;
+    bool                     quiet              = false;
+    std::vector<std::string> test_columns;
+
+    Geometry<dim>        geometry;
+    FluidParameters<dim> fluid_parameters;
+
+    RunLog                     log;
+    dealii::ConditionalOStream pcout;
+    dealii::TimerOutput        timer;
+    Statistics                 statistics;
+
+    dealii::parallel::distributed::Triangulation<dim> triangulation;
+    std::unique_ptr<FluidSolver<dim>>                 fluid;
+    std::unique_ptr<FieldOutput<dim>>                 field_output;
+
+    double       time = 0;
+    unsigned int step = 0;
+    double       wall_start;
+  };
+} // namespace ImmersedGrains
+
+#endif

@@ -1,0 +1,9 @@
+# Sourced by the scripts: Open MPI refuses to run as root (CI, containers)
+# unless told, and must be allowed to oversubscribe a 2-core machine.
+export OMPI_ALLOW_RUN_AS_ROOT=1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_rmaps_base_oversubscribe=1
+# deal.II and Trilinos threads fight with MPI ranks on small machines.
+export DEAL_II_NUM_THREADS=${DEAL_II_NUM_THREADS:-1}
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+export CCACHE_DIR=${CCACHE_DIR:-$HOME/.ccache}

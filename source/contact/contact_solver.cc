@@ -1,0 +1,774 @@
+#include <deal.II/base/exceptions.h>
+
+#include <immersed_grains/contact/contact_solver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+// The scheme (Moreau 1988, "Unilateral contact and dry friction in finite
+// freedom dynamics", CISM Courses 302; Jean 1999, "The non-smooth contact
+// dynamics method", CMAME 177, 235-257), implicit in the velocity
+// (theta = 1):
+//
+//   v^{n+1} = v_free + M_eff^{-1} sum_a H_a p_a,   x^{n+1} = x^n + dt v^{n+1},
+//
+// with v_free = v^n + dt F / m_eff from the caller and p_a the impulse of
+// contact a over the step (mean force p_a / dt).
+//
+// Normal law. u_n = (v_j - v_i).n is the relative normal velocity (positive
+// when separating), g the gap at the start of the step. The gap at the end of
+// the step is g + dt u_n^+ (to the order of the position update), so
+// non-penetration at the end of the step reads u_n^+ >= -g/dt: Signorini's
+// condition at velocity level with the gap term of Jean 1999. An open contact
+// may close exactly within the step, and an overlap left by earlier steps is
+// removed within one step instead of drifting. Newton's impact law (Moreau
+// 1988; Jean 1999) asks u_n^+ >= -e u_n^-, with u_n^- the pre-impact
+// velocity, taken at the start of the step. Together, per contact,
+//
+//   0 <= p_n  _|_  u_n^+ - ubar_n >= 0,
+//   ubar_n = max(-g/dt, -e u_n^-)   if the contact impacts during the step,
+//   ubar_n = -g/dt                  otherwise.
+//
+// A contact impacts when (i) it closes within the free step,
+// g + dt u_n^free < 0, so that pairs merely inside the alert distance do not
+// bounce from afar, and (ii) it approaches faster than the free step alone
+// makes it, u_n^- < -|u_n^free - u_n^-|. (ii) tells impacts from lasting
+// contacts: the approach speed a resting contact gains from the applied
+// forces within one step is no impact, and treating it as one makes a ball
+// under gravity chatter with ever smaller bounces instead of coming to rest
+// in finite time. The threshold vanishes with dt, where Newton's law holds
+// for every impact. ubar_n is fixed at setup, so the problem stays a linear
+// complementarity problem for which Gauss-Seidel converges.
+//
+// Friction: Coulomb's law |p_t| <= mu p_n, u_t^+ = 0 while |p_t| < mu p_n,
+// else p_t = -mu p_n u_t^+ / |u_t^+| (Jean 1999). With the contact point at
+// x_i + r_i n on grain i and x_j - r_j n on grain j,
+//
+//   u = v_j - v_i - (r_i w_i + r_j w_j) x n,
+//
+// and an impulse P on j (-P on i) changes it by W P with
+//
+//   W = w_n n(x)n + w_t (1 - n(x)n),  w_n = 1/m_i + 1/m_j,
+//   w_t = w_n + r_i^2 / I_i + r_j^2 / I_j,
+//
+// since rotation acts only tangentially ((n x t) x n = t for t _|_ n). W is
+// diagonal in (normal, tangent plane) and isotropic in the plane, so the
+// exact solution of the one-contact problem is a projection (Alart & Curnier
+// 1991, CMAME 92, 353-375):
+//
+//   p_n <- max(0, p_n + (ubar_n - u_n) / w_n),
+//   p_t <- proj_{|q| <= mu p_n} (p_t - u_t / w_t).
+//
+// Projected Gauss-Seidel applies this contact by contact with the
+// velocities updated in place (Jean 1999, "NLGS").
+
+namespace ImmersedGrains
+{
+  namespace Contact
+  {
+    namespace
+    {
+      // Wall keys live above every grain id in the second key component.
+      constexpr std::uint64_t wall_key_bit = std::uint64_t(1) << 63;
+
+      // out = s x n: s an angular velocity (scalar in 2D), n in the plane.
+      template <int dim>
+      inline void
+      spin_cross(const double *s, const double *n, double *out)
+      {
+        if constexpr (dim == 2)
+          {
+            out[0] = -s[0] * n[1];
+            out[1] = s[0] * n[0];
+          }
+        else
+          {
+            out[0] = s[1] * n[2] - s[2] * n[1];
+            out[1] = s[2] * n[0] - s[0] * n[2];
+            out[2] = s[0] * n[1] - s[1] * n[0];
+          }
+      }
+
+      // out = n x p for two vectors of the space (a scalar in 2D).
+      template <int dim>
+      inline void
+      vector_cross(const double *n, const double *p, double *out)
+      {
+        if constexpr (dim == 2)
+          out[0] = n[0] * p[1] - n[1] * p[0];
+        else
+          {
+            out[0] = n[1] * p[2] - n[2] * p[1];
+            out[1] = n[2] * p[0] - n[0] * p[2];
+            out[2] = n[0] * p[1] - n[1] * p[0];
+          }
+      }
+    } // namespace
+
+
+
+    template <int dim>
+    ContactSolver<dim>::ContactSolver(const ContactParameters &parameters)
+      : dt(0)
+      , n_grains(0)
+      , n_pairs(0)
+      , forward(true)
+      , smallest_radius(0)
+    {
+      set_parameters(parameters);
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::set_parameters(const ContactParameters &p)
+    {
+      AssertThrow(p.restitution >= 0 && p.restitution <= 1,
+                  dealii::ExcMessage(
+                    "ContactSolver: the restitution must lie in [0, 1]."));
+      AssertThrow(p.friction >= 0,
+                  dealii::ExcMessage(
+                    "ContactSolver: the friction coefficient must not be "
+                    "negative."));
+      AssertThrow(p.tolerance > 0 && p.overlap_tolerance > 0,
+                  dealii::ExcMessage(
+                    "ContactSolver: the tolerances must be positive."));
+      AssertThrow(p.max_iterations > 0,
+                  dealii::ExcMessage(
+                    "ContactSolver: at least one iteration is needed."));
+      parameters = p;
+    }
+
+
+
+    template <int dim>
+    const ContactParameters &
+    ContactSolver<dim>::get_parameters() const
+    {
+      return parameters;
+    }
+
+
+
+    template <int dim>
+    SolverResult
+    ContactSolver<dim>::solve(const std::vector<GrainPair<dim>>   &pairs,
+                              const std::vector<WallContact<dim>> &wall_contacts,
+                              const std::vector<Tensor<1, dim>> &wall_velocities,
+                              GrainArrays<dim>                  &grain_arrays,
+                              const double                       time_step)
+    {
+      setup(pairs, wall_contacts, wall_velocities, grain_arrays, time_step);
+
+      SolverResult result;
+      result.n_contacts = rows.size();
+      if (rows.empty())
+        result.converged = true;
+      // The overlap is only worth a pass over the contacts once the impulses
+      // have settled.
+      double overlap = 0;
+      while (!result.converged && result.iterations < parameters.max_iterations)
+        {
+          const SweepResult s = sweep();
+          ++result.iterations;
+          result.residual =
+            (s.max_impulse > 0 ? s.max_change / s.max_impulse : 0.);
+          if (s.max_change <= parameters.tolerance * s.max_impulse)
+            {
+              overlap          = predicted_max_overlap();
+              result.converged = converged(s, overlap);
+            }
+        }
+      result.max_overlap =
+        (result.converged ? overlap : predicted_max_overlap());
+
+      finish(grain_arrays);
+      for (const Row &row : rows)
+        result.n_active += (row.p_n > 0);
+      return result;
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::setup(const std::vector<GrainPair<dim>>   &pairs,
+                              const std::vector<WallContact<dim>> &wall_contacts,
+                              const std::vector<Tensor<1, dim>> &wall_velocities,
+                              const GrainArrays<dim>            &grain_arrays,
+                              const double                       time_step)
+    {
+      const unsigned int n        = grain_arrays.velocity.size();
+      const bool         friction = (parameters.friction > 0);
+      AssertThrow(time_step > 0,
+                  dealii::ExcMessage(
+                    "ContactSolver: the time step must be positive."));
+      AssertThrow(grain_arrays.inverse_mass.size() == n &&
+                    grain_arrays.radius.size() == n,
+                  dealii::ExcMessage("ContactSolver: GrainArrays need one "
+                                     "inverse mass and radius per velocity."));
+      AssertThrow(!friction || (grain_arrays.angular_velocity.size() == n &&
+                                grain_arrays.inverse_inertia.size() == n),
+                  dealii::ExcMessage(
+                    "ContactSolver: with friction, GrainArrays need one "
+                    "angular velocity and inverse inertia per grain."));
+      AssertThrow(grain_arrays.start_velocity.empty() ||
+                    grain_arrays.start_velocity.size() == n,
+                  dealii::ExcMessage(
+                    "ContactSolver: start_velocity must be empty or have "
+                    "one entry per grain."));
+      AssertThrow(grain_arrays.id.empty() || grain_arrays.id.size() == n,
+                  dealii::ExcMessage(
+                    "ContactSolver: id must be empty or have one entry per "
+                    "grain."));
+
+      dt       = time_step;
+      n_grains = n;
+      n_pairs  = pairs.size();
+      forward  = true;
+
+      // Walls are grains of zero inverse mass after the real ones, so that
+      // one loop without branches serves both kinds of contact.
+      const unsigned int n_walls = wall_velocities.size();
+      grains.resize(n + n_walls);
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          for (unsigned int d = 0; d < dim; ++d)
+            grains[i].velocity[d] = grain_arrays.velocity[i][d];
+          grains[i].inverse_mass = grain_arrays.inverse_mass[i];
+        }
+      for (unsigned int w = 0; w < n_walls; ++w)
+        {
+          for (unsigned int d = 0; d < dim; ++d)
+            grains[n + w].velocity[d] = wall_velocities[w][d];
+          grains[n + w].inverse_mass = 0;
+        }
+      spins.clear();
+      if (friction)
+        {
+          spins.resize(n + n_walls, SpinSlot{{}, 0.});
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              for (unsigned int d = 0; d < spin_dim; ++d)
+                spins[i].angular_velocity[d] =
+                  grain_arrays.angular_velocity[i][d];
+              spins[i].inverse_inertia = grain_arrays.inverse_inertia[i];
+            }
+        }
+
+      const unsigned int n_rows = pairs.size() + wall_contacts.size();
+      rows.clear();
+      friction_rows.clear();
+      gaps.clear();
+      keys.clear();
+      key_sign.clear();
+      rows.reserve(n_rows);
+      gaps.reserve(n_rows);
+      keys.reserve(n_rows);
+      key_sign.reserve(n_rows);
+      if (friction)
+        friction_rows.reserve(n_rows);
+      smallest_radius = std::numeric_limits<double>::max();
+
+      const auto id = [&](const unsigned int i) -> std::uint64_t {
+        return grain_arrays.id.empty() ? i : grain_arrays.id[i];
+      };
+      for (const GrainPair<dim> &pair : pairs)
+        {
+          AssertThrow(pair.first < n && pair.second < n &&
+                        pair.first != pair.second,
+                      dealii::ExcMessage(
+                        "ContactSolver: a pair names a grain that does not "
+                        "exist, or the same grain twice."));
+          add_row(pair.first, pair.second, pair.normal, pair.gap, grain_arrays);
+          const std::uint64_t a = id(pair.first), b = id(pair.second);
+          keys.emplace_back(std::min(a, b), std::max(a, b));
+          key_sign.push_back(a < b ? 1. : -1.);
+        }
+      for (const WallContact<dim> &contact : wall_contacts)
+        {
+          AssertThrow(contact.grain < n && contact.wall < n_walls,
+                      dealii::ExcMessage(
+                        "ContactSolver: a wall contact names a grain or a "
+                        "wall that does not exist."));
+          add_row(contact.grain,
+                  n + contact.wall,
+                  contact.normal,
+                  contact.gap,
+                  grain_arrays);
+          keys.emplace_back(id(contact.grain), wall_key_bit | contact.wall);
+          key_sign.push_back(1.);
+        }
+      if (rows.empty())
+        smallest_radius = 0;
+
+      if (parameters.warm_start)
+        warm_start();
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::add_row(const unsigned int      i,
+                                const unsigned int      j,
+                                const Tensor<1, dim>   &normal,
+                                const double            gap,
+                                const GrainArrays<dim> &grain_arrays)
+    {
+      Row row;
+      row.i   = i;
+      row.j   = j;
+      row.p_n = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        row.normal[d] = normal[d];
+
+      const double w_n = grains[i].inverse_mass + grains[j].inverse_mass;
+      row.inverse_w    = (w_n > 0 ? 1. / w_n : 0.);
+
+      // The work arrays hold the free velocities until warm_start().
+      double u_free = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        u_free += (grains[j].velocity[d] - grains[i].velocity[d]) * normal[d];
+      double u_start = u_free;
+      if (!grain_arrays.start_velocity.empty())
+        {
+          // A wall's velocity is the same at the start and after the free
+          // step.
+          const Tensor<1, dim> v_j =
+            (j < n_grains ? grain_arrays.start_velocity[j] :
+                            Tensor<1, dim>(grains[j].velocity));
+          u_start = (v_j - grain_arrays.start_velocity[i]) * normal;
+        }
+
+      const double e           = parameters.restitution;
+      const double closing     = -gap / dt;
+      const bool   closes      = (u_free < closing);
+      const bool   fast_enough = (u_start < -std::abs(u_free - u_start));
+      const bool   impacts     = (e > 0 && closes && fast_enough);
+      row.target = (impacts ? std::max(closing, -e * u_start) : closing);
+      rows.push_back(row);
+      gaps.push_back(gap);
+
+      const double r_i = grain_arrays.radius[i];
+      const double r_j = (j < n_grains ? grain_arrays.radius[j] : 0.);
+      smallest_radius  = std::min(smallest_radius, r_i);
+      if (j < n_grains)
+        smallest_radius = std::min(smallest_radius, r_j);
+
+      if (parameters.friction > 0)
+        {
+          FrictionRow f{};
+          f.radius_i = r_i;
+          f.radius_j = r_j;
+          const double w_t =
+            w_n + r_i * r_i * spins[i].inverse_inertia +
+            r_j * r_j * spins[j].inverse_inertia;
+          f.inverse_w_t = (w_t > 0 ? 1. / w_t : 0.);
+          friction_rows.push_back(f);
+        }
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::warm_start()
+    {
+      if (cache.empty())
+        return;
+
+      // Both the new keys and the cache are mostly sorted: search forward
+      // from the last hit with a doubling step, and start over only where
+      // the new keys go back (from the pairs to the walls).
+      const std::size_t n_cached = cache.size();
+      std::size_t       cursor   = 0;
+      Key               last(0, 0);
+      const bool        friction = (parameters.friction > 0);
+      for (unsigned int k = 0; k < rows.size(); ++k)
+        {
+          const Key &key = keys[k];
+          if (key < last)
+            cursor = 0;
+          last = key;
+
+          std::size_t lo = cursor, step = 1, hi = cursor;
+          while (hi < n_cached && cache[hi].key < key)
+            {
+              lo = hi + 1;
+              hi += step;
+              step *= 2;
+            }
+          hi     = std::min(hi + 1, n_cached);
+          cursor = std::lower_bound(cache.begin() + lo,
+                                    cache.begin() + hi,
+                                    key,
+                                    [](const CachedImpulse &c, const Key &k) {
+                                      return c.key < k;
+                                    }) -
+                   cache.begin();
+          if (cursor == n_cached || cache[cursor].key != key)
+            continue;
+
+          Row &row = rows[k];
+          row.p_n  = cache[cursor].p_n;
+          double p_t[dim] = {};
+          if (friction)
+            {
+              // The normal has turned since the last step: keep the part of
+              // the old tangential impulse in the new tangent plane, inside
+              // the cone.
+              Tensor<1, dim> normal, t = key_sign[k] * cache[cursor].p_t;
+              for (unsigned int d = 0; d < dim; ++d)
+                normal[d] = row.normal[d];
+              t -= (t * normal) * normal;
+              const double limit = parameters.friction * row.p_n;
+              const double norm  = t.norm();
+              if (norm > limit)
+                t *= limit / norm;
+              for (unsigned int d = 0; d < dim; ++d)
+                p_t[d] = friction_rows[k].p_t[d] = t[d];
+            }
+          apply_impulse(k, row.p_n, p_t);
+        }
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::apply_impulse(const unsigned int k,
+                                      const double       dp_n,
+                                      const double      *dp_t)
+    {
+      const Row &row = rows[k];
+      GrainSlot &a   = grains[row.i];
+      GrainSlot &b   = grains[row.j];
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double P = dp_n * row.normal[d] + dp_t[d];
+          a.velocity[d] -= a.inverse_mass * P;
+          b.velocity[d] += b.inverse_mass * P;
+        }
+      if (parameters.friction > 0)
+        {
+          const FrictionRow &f = friction_rows[k];
+          double             torque[spin_dim];
+          vector_cross<dim>(row.normal, dp_t, torque);
+          SpinSlot &sa = spins[row.i];
+          SpinSlot &sb = spins[row.j];
+          for (unsigned int d = 0; d < spin_dim; ++d)
+            {
+              sa.angular_velocity[d] -= sa.inverse_inertia * f.radius_i *
+                                        torque[d];
+              sb.angular_velocity[d] -= sb.inverse_inertia * f.radius_j *
+                                        torque[d];
+            }
+        }
+    }
+
+
+
+    template <int dim>
+    SweepResult
+    ContactSolver<dim>::sweep()
+    {
+      const SweepResult result =
+        (parameters.friction > 0 ? sweep_rows<true>() : sweep_rows<false>());
+      // Alternating the order lets information cross a chain of contacts in
+      // both directions at the same speed (a column on a floor converges
+      // no matter in which order its contacts were listed).
+      forward = !forward;
+      return result;
+    }
+
+
+
+    template <int dim>
+    template <bool with_friction>
+    SweepResult
+    ContactSolver<dim>::sweep_rows()
+    {
+      GrainSlot *const   g        = grains.data();
+      SpinSlot *const    s        = spins.data();
+      Row *const         rw       = rows.data();
+      FrictionRow *const fr       = friction_rows.data();
+      const double       mu       = parameters.friction;
+      const long         n        = rows.size();
+      const long         start    = (forward ? 0 : n - 1);
+      const long         stride   = (forward ? 1 : -1);
+      double             max_d2   = 0; // squared, to spare the root
+      double             max_p2   = 0;
+
+      for (long q = 0; q < n; ++q)
+        {
+          const long k   = start + q * stride;
+          Row       &row = rw[k];
+          GrainSlot &a   = g[row.i];
+          GrainSlot &b   = g[row.j];
+
+          if constexpr (!with_friction)
+            {
+              double u_n = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                u_n += (b.velocity[d] - a.velocity[d]) * row.normal[d];
+              const double p =
+                std::max(0., row.p_n + row.inverse_w * (row.target - u_n));
+              const double dp = p - row.p_n;
+              row.p_n         = p;
+              const double da = a.inverse_mass * dp;
+              const double db = b.inverse_mass * dp;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  a.velocity[d] -= da * row.normal[d];
+                  b.velocity[d] += db * row.normal[d];
+                }
+              max_d2 = std::max(max_d2, dp * dp);
+              max_p2 = std::max(max_p2, p * p);
+            }
+          else
+            {
+              FrictionRow &f  = fr[k];
+              SpinSlot    &sa = s[row.i];
+              SpinSlot    &sb = s[row.j];
+
+              double spin[spin_dim], lever[dim];
+              for (unsigned int d = 0; d < spin_dim; ++d)
+                spin[d] = f.radius_i * sa.angular_velocity[d] +
+                          f.radius_j * sb.angular_velocity[d];
+              spin_cross<dim>(spin, row.normal, lever);
+              double u[dim], u_n = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  u[d] = b.velocity[d] - a.velocity[d] - lever[d];
+                  u_n += u[d] * row.normal[d];
+                }
+
+              const double p_n =
+                std::max(0., row.p_n + row.inverse_w * (row.target - u_n));
+              const double dp_n = p_n - row.p_n;
+              row.p_n           = p_n;
+
+              double p_t[dim], norm2 = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  p_t[d] = f.p_t[d] -
+                           f.inverse_w_t * (u[d] - u_n * row.normal[d]);
+                  norm2 += p_t[d] * p_t[d];
+                }
+              const double limit = mu * p_n;
+              if (norm2 > limit * limit)
+                {
+                  const double scale = limit / std::sqrt(norm2);
+                  for (unsigned int d = 0; d < dim; ++d)
+                    p_t[d] *= scale;
+                }
+
+              double dp[dim], dp_t[dim], change2 = dp_n * dp_n, p2 = p_n * p_n;
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  dp_t[d] = p_t[d] - f.p_t[d];
+                  f.p_t[d] = p_t[d];
+                  dp[d]    = dp_n * row.normal[d] + dp_t[d];
+                  a.velocity[d] -= a.inverse_mass * dp[d];
+                  b.velocity[d] += b.inverse_mass * dp[d];
+                  change2 += dp_t[d] * dp_t[d];
+                  p2 += p_t[d] * p_t[d];
+                }
+              double torque[spin_dim];
+              vector_cross<dim>(row.normal, dp_t, torque);
+              for (unsigned int d = 0; d < spin_dim; ++d)
+                {
+                  sa.angular_velocity[d] -=
+                    sa.inverse_inertia * f.radius_i * torque[d];
+                  sb.angular_velocity[d] -=
+                    sb.inverse_inertia * f.radius_j * torque[d];
+                }
+              max_d2 = std::max(max_d2, change2);
+              max_p2 = std::max(max_p2, p2);
+            }
+        }
+      return {std::sqrt(max_d2), std::sqrt(max_p2)};
+    }
+
+
+
+    template <int dim>
+    double
+    ContactSolver<dim>::predicted_max_overlap() const
+    {
+      double overlap = 0;
+      for (unsigned int k = 0; k < rows.size(); ++k)
+        {
+          const Row &row = rows[k];
+          // Between two fixed grains nothing can be done: not our failure.
+          if (row.inverse_w == 0)
+            continue;
+          double u_n = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            u_n += (grains[row.j].velocity[d] - grains[row.i].velocity[d]) *
+                   row.normal[d];
+          overlap = std::max(overlap, -(gaps[k] + dt * u_n));
+        }
+      return overlap;
+    }
+
+
+
+    template <int dim>
+    double
+    ContactSolver<dim>::overlap_limit() const
+    {
+      return parameters.overlap_tolerance * smallest_radius;
+    }
+
+
+
+    template <int dim>
+    bool
+    ContactSolver<dim>::converged(const SweepResult &s,
+                                  const double       max_overlap) const
+    {
+      return s.max_change <= parameters.tolerance * s.max_impulse &&
+             max_overlap <= overlap_limit();
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::finish(GrainArrays<dim> &grain_arrays)
+    {
+      AssertThrow(grain_arrays.velocity.size() == n_grains,
+                  dealii::ExcMessage(
+                    "ContactSolver: finish() needs the GrainArrays given to "
+                    "setup()."));
+      const bool friction = (parameters.friction > 0);
+      for (unsigned int i = 0; i < n_grains; ++i)
+        {
+          for (unsigned int d = 0; d < dim; ++d)
+            grain_arrays.velocity[i][d] = grains[i].velocity[d];
+          if (friction)
+            for (unsigned int d = 0; d < spin_dim; ++d)
+              grain_arrays.angular_velocity[i][d] =
+                spins[i].angular_velocity[d];
+        }
+
+      const unsigned int n_rows = rows.size();
+      pair_results.normal.resize(n_pairs);
+      pair_results.tangential.resize(n_pairs);
+      wall_results.normal.resize(n_rows - n_pairs);
+      wall_results.tangential.resize(n_rows - n_pairs);
+      cache.clear();
+      for (unsigned int k = 0; k < n_rows; ++k)
+        {
+          Tensor<1, dim> p_t;
+          if (friction)
+            for (unsigned int d = 0; d < dim; ++d)
+              p_t[d] = friction_rows[k].p_t[d];
+          ContactImpulses<dim> &out =
+            (k < n_pairs ? pair_results : wall_results);
+          const unsigned int m = (k < n_pairs ? k : k - n_pairs);
+          out.normal[m]        = rows[k].p_n;
+          out.tangential[m]    = p_t;
+          if (rows[k].p_n > 0)
+            cache.push_back({keys[k], rows[k].p_n, key_sign[k] * p_t});
+        }
+
+      // Pairs and walls each come sorted from the neighbour searches, so
+      // this is a merge; a caller with other orders pays a sort.
+      const auto by_key = [](const CachedImpulse &a, const CachedImpulse &b) {
+        return a.key < b.key;
+      };
+      const auto middle = std::find_if(cache.begin(),
+                                       cache.end(),
+                                       [](const CachedImpulse &c) {
+                                         return (c.key.second &
+                                                 wall_key_bit) != 0;
+                                       });
+      if (!std::is_sorted(cache.begin(), middle, by_key))
+        std::sort(cache.begin(), middle, by_key);
+      if (!std::is_sorted(middle, cache.end(), by_key))
+        std::sort(middle, cache.end(), by_key);
+      std::inplace_merge(cache.begin(), middle, cache.end(), by_key);
+    }
+
+
+
+    template <int dim>
+    const ContactImpulses<dim> &
+    ContactSolver<dim>::pair_impulses() const
+    {
+      return pair_results;
+    }
+
+
+
+    template <int dim>
+    const ContactImpulses<dim> &
+    ContactSolver<dim>::wall_impulses() const
+    {
+      return wall_results;
+    }
+
+
+
+    template <int dim>
+    Tensor<1, dim>
+    ContactSolver<dim>::get_velocity(const unsigned int grain) const
+    {
+      AssertIndexRange(grain, n_grains);
+      Tensor<1, dim> v;
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = grains[grain].velocity[d];
+      return v;
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::set_velocity(const unsigned int    grain,
+                                     const Tensor<1, dim> &velocity)
+    {
+      AssertIndexRange(grain, n_grains);
+      for (unsigned int d = 0; d < dim; ++d)
+        grains[grain].velocity[d] = velocity[d];
+    }
+
+
+
+    template <int dim>
+    AngularVelocity<dim>
+    ContactSolver<dim>::get_angular_velocity(const unsigned int grain) const
+    {
+      AssertIndexRange(grain, n_grains);
+      AngularVelocity<dim> w;
+      if (!spins.empty())
+        for (unsigned int d = 0; d < spin_dim; ++d)
+          w[d] = spins[grain].angular_velocity[d];
+      return w;
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::set_angular_velocity(
+      const unsigned int          grain,
+      const AngularVelocity<dim> &angular_velocity)
+    {
+      AssertIndexRange(grain, n_grains);
+      if (!spins.empty())
+        for (unsigned int d = 0; d < spin_dim; ++d)
+          spins[grain].angular_velocity[d] = angular_velocity[d];
+    }
+
+
+
+    template class ContactSolver<2>;
+    template class ContactSolver<3>;
+  } // namespace Contact
+} // namespace ImmersedGrains

@@ -1,0 +1,143 @@
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <immersed_grains/fluid/block_preconditioner.h>
+#include <immersed_grains/fluid/fluid_solver.h>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  void
+  FluidSolver<dim>::build_preconditioner()
+  {
+    dealii::TimerOutput::Scope scope(timer, "fluid: preconditioner");
+
+    BlockSchurPreconditioner::Settings settings;
+    settings.velocity_cycles = parameters.velocity_amg_cycles;
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    dealii::DoFTools::extract_constant_modes(dof_handler,
+                                             fe.component_mask(velocities),
+                                             settings.velocity_constant_modes);
+
+    const bool mass_term =
+      parameters.schur_approximation != SchurApproximation::pressure_laplace;
+    const bool laplace_term =
+      parameters.schur_approximation != SchurApproximation::pressure_mass &&
+      schur_laplace_weight > 0;
+    preconditioner = std::make_unique<BlockSchurPreconditioner>(
+      system_matrix,
+      (mass_term || !laplace_term) ? &pressure_mass_matrix.block(1, 1) : nullptr,
+      laplace_term ? &pressure_laplace_matrix.block(1, 1) : nullptr,
+      settings);
+  }
+
+
+  namespace
+  {
+    // Copies a block matrix whose blocks are contiguous ranges of the global
+    // DoF numbering into one matrix, for a sparse direct solver.
+    void
+    copy_to_monolithic(const dealii::TrilinosWrappers::BlockSparseMatrix &blocks,
+                       dealii::TrilinosWrappers::SparseMatrix            &matrix)
+    {
+      dealii::types::global_dof_index offsets[2] = {0, blocks.block(0, 0).m()};
+      for (unsigned int bi = 0; bi < 2; ++bi)
+        for (unsigned int bj = 0; bj < 2; ++bj)
+          {
+            const auto &block = blocks.block(bi, bj);
+            for (const auto row : block.locally_owned_range_indices())
+              for (auto entry = block.begin(row); entry != block.end(row); ++entry)
+                if (entry->value() != 0)
+                  matrix.set(row + offsets[bi],
+                             entry->column() + offsets[bj],
+                             entry->value());
+          }
+      matrix.compress(dealii::VectorOperation::insert);
+    }
+  } // namespace
+
+
+  template <int dim>
+  unsigned int
+  FluidSolver<dim>::solve_linear_system()
+  {
+    if (parameters.direct_solver)
+      {
+        dealii::TimerOutput::Scope scope(timer, "fluid: direct solve");
+        const dealii::IndexSet owned = dof_handler.locally_owned_dofs();
+        // Rows are filled by insertion: fine for the small problems this
+        // path is meant for.
+        dealii::TrilinosWrappers::SparseMatrix matrix(
+          owned, owned, mpi_communicator, 30 * (dim + 1) * (dim == 3 ? 3 : 1));
+        copy_to_monolithic(system_matrix, matrix);
+        dealii::TrilinosWrappers::MPI::Vector x(owned, mpi_communicator),
+          b(owned, mpi_communicator);
+        const dealii::types::global_dof_index n_u = system_matrix.block(0, 0).m();
+        for (unsigned int bi = 0; bi < 2; ++bi)
+          for (const auto i : owned_partitioning[bi])
+            b[i + (bi == 0 ? 0 : n_u)] = system_rhs.block(bi)[i];
+        b.compress(dealii::VectorOperation::insert);
+
+        // A singular (pure-Neumann pressure) system has one zero pivot; pin
+        // one pressure DoF of the update, the mean is fixed afterwards.
+        if (pressure_has_null_space())
+          {
+            const auto pinned = n_u;
+            if (owned.is_element(pinned))
+              {
+                for (auto entry = matrix.begin(pinned); entry != matrix.end(pinned);
+                     ++entry)
+                  entry->value() = (entry->column() == pinned) ? 1.0 : 0.0;
+                b[pinned] = 0;
+              }
+            matrix.compress(dealii::VectorOperation::insert);
+            b.compress(dealii::VectorOperation::insert);
+          }
+
+        dealii::SolverControl                    control(1, 0);
+        dealii::TrilinosWrappers::SolverDirect   solver(control);
+        solver.solve(matrix, x, b);
+        for (unsigned int bi = 0; bi < 2; ++bi)
+          for (const auto i : owned_partitioning[bi])
+            newton_update.block(bi)[i] = x[i + (bi == 0 ? 0 : n_u)];
+        newton_update.compress(dealii::VectorOperation::insert);
+        return 1;
+      }
+
+    build_preconditioner();
+    dealii::TimerOutput::Scope scope(timer, "fluid: solve");
+    const double                tolerance =
+      parameters.linear_tolerance * system_rhs.l2_norm();
+    dealii::SolverControl       control(parameters.max_linear_iterations,
+                                  tolerance);
+    dealii::SolverFGMRES<VectorType> solver(
+      control,
+      typename dealii::SolverFGMRES<VectorType>::AdditionalData(100));
+    newton_update = 0;
+    try
+      {
+        solver.solve(system_matrix, newton_update, system_rhs, *preconditioner);
+      }
+    catch (const dealii::SolverControl::NoConvergence &e)
+      {
+        AssertThrow(false,
+                    dealii::ExcMessage(
+                      "Fluid: FGMRES did not converge in " +
+                      std::to_string(e.last_step) +
+                      " iterations (residual " + std::to_string(e.last_residual) +
+                      ", Fluid/Linear solver/Max iterations = " +
+                      std::to_string(parameters.max_linear_iterations) + ")."));
+      }
+    return control.last_step();
+  }
+
+
+  template void FluidSolver<2>::build_preconditioner();
+  template void FluidSolver<3>::build_preconditioner();
+  template unsigned int FluidSolver<2>::solve_linear_system();
+  template unsigned int FluidSolver<3>::solve_linear_system();
+} // namespace ImmersedGrains

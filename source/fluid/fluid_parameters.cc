@@ -1,0 +1,270 @@
+#include <deal.II/base/exceptions.h>
+
+#include <immersed_grains/fluid/fluid_parameters.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    // The prescribed fields, their components and defaults, in one table so
+    // that declaration and parsing cannot drift apart.
+    struct FieldEntry
+    {
+      const char  *name;
+      bool         vector_valued;
+      const char  *default_value;
+      const char  *documentation;
+    };
+
+    const FieldEntry field_entries[] = {
+      {"Fluid fraction",
+       false,
+       "1",
+       "Prescribed fluid fraction phi(x,t) in (0,1] when no grains are "
+       "simulated."},
+      {"Drag coefficient",
+       false,
+       "0",
+       "Prescribed drag coefficient beta(x,t) [kg/(m^3 s)] of the term "
+       "beta (u_f - u_p) when no grains are simulated."},
+      {"Grain velocity",
+       true,
+       "0",
+       "Prescribed grain velocity field u_p(x,t) [m/s] when no grains are "
+       "simulated."},
+      {"Forcing",
+       true,
+       "0",
+       "Body force per unit volume f(x,t) [N/m^3] on the fluid (the "
+       "hydrostatic part of gravity is already in the pressure)."},
+      {"Boundary velocity",
+       true,
+       "0",
+       "Fluid velocity on faces whose boundary condition is 'velocity'."},
+      {"Open boundary pressure",
+       false,
+       "0",
+       "Pressure (minus hydrostatic) imposed weakly on 'open' faces."},
+      {"Initial velocity", true, "0", "Fluid velocity at t = 0."}};
+
+    std::string
+    vector_default(const char *component, const int dim)
+    {
+      std::string s = component;
+      for (int d = 1; d < dim; ++d)
+        s += std::string("; ") + component;
+      return s;
+    }
+  } // namespace
+
+
+  template <int dim>
+  void
+  FluidParameters<dim>::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii::Patterns;
+    prm.enter_subsection("Fluid");
+    {
+      prm.declare_entry("Enabled",
+                        "true",
+                        Bool(),
+                        "Solve the averaged fluid. Without it grains move in "
+                        "vacuum (dry granular scenes).");
+      prm.declare_entry("Density", "1000", Double(), "Fluid density rho [kg/m^3].");
+      prm.declare_entry("Viscosity",
+                        "1e-3",
+                        Double(),
+                        "Dynamic viscosity mu [Pa s].");
+      prm.declare_entry("Advection",
+                        "true",
+                        Bool(),
+                        "Keep the advection term phi rho (u.grad)u "
+                        "(Navier-Stokes); false gives Stokes.");
+      prm.declare_entry("Time derivative",
+                        "true",
+                        Bool(),
+                        "Keep phi rho du/dt; false solves a steady problem at "
+                        "every step.");
+      prm.declare_entry("Time scheme",
+                        "BDF2",
+                        Selection("BDF1|BDF2"),
+                        "Implicit Euler (BDF1) or second-order BDF with "
+                        "variable step (the first step is BDF1).");
+      prm.declare_entry("Linearization",
+                        "Picard",
+                        Selection("Picard|Newton"),
+                        "How the advection term is linearised.");
+      prm.declare_entry("Nonlinear tolerance",
+                        "1e-8",
+                        Double(0),
+                        "Relative reduction of the nonlinear residual.");
+      prm.declare_entry("Max nonlinear iterations", "20", Integer(1));
+
+      prm.enter_subsection("Linear solver");
+      {
+        prm.declare_entry("Type",
+                          "iterative",
+                          Selection("iterative|direct"),
+                          "FGMRES with the block preconditioner, or a sparse "
+                          "direct solver (Amesos KLU; small problems only).");
+        prm.declare_entry("Tolerance",
+                          "1e-8",
+                          Double(0),
+                          "Relative residual reduction of the outer solver.");
+        prm.declare_entry("Max iterations", "500", Integer(1));
+        prm.declare_entry(
+          "Schur complement",
+          "Cahouet-Chabard",
+          Selection("Cahouet-Chabard|pressure mass|pressure Laplacian"),
+          "Approximation of the inverse Schur complement: the sum of the "
+          "phi/mu-weighted pressure mass matrix and the phi^2/(phi rho a0/dt "
+          "+ beta)-weighted pressure Laplacian (Cahouet-Chabard), or one of "
+          "its two limits.");
+        prm.declare_entry("Velocity AMG cycles",
+                          "1",
+                          Integer(1, 10),
+                          "AMG V-cycles per application of the velocity "
+                          "block's inverse.");
+      }
+      prm.leave_subsection();
+
+      for (const FieldEntry &f : field_entries)
+        {
+          prm.enter_subsection(f.name);
+          dealii::Functions::ParsedFunction<dim>::declare_parameters(
+            prm, f.vector_valued ? dim : 1);
+          prm.set("Function expression",
+                  f.vector_valued ? vector_default(f.default_value, dim) :
+                                    std::string(f.default_value));
+          prm.leave_subsection();
+        }
+    }
+    prm.leave_subsection();
+  }
+
+
+  template <int dim>
+  void
+  FluidParameters<dim>::parse_parameters(dealii::ParameterHandler &prm,
+                                         const std::string        &file,
+                                         const Geometry<dim>      &geometry)
+  {
+    const InputLocation where{file, "Fluid"};
+    prm.enter_subsection("Fluid");
+    {
+      enabled   = prm.get_bool("Enabled");
+      density   = prm.get_double("Density");
+      viscosity = prm.get_double("Viscosity");
+      where.require(density > 0,
+                    "Density",
+                    prm.get("Density"),
+                    "must be positive");
+      where.require(viscosity > 0,
+                    "Viscosity",
+                    prm.get("Viscosity"),
+                    "must be positive");
+      advection                = prm.get_bool("Advection");
+      time_derivative          = prm.get_bool("Time derivative");
+      bdf_order                = prm.get("Time scheme") == "BDF2" ? 2 : 1;
+      newton                   = prm.get("Linearization") == "Newton";
+      nonlinear_tolerance      = prm.get_double("Nonlinear tolerance");
+      max_nonlinear_iterations = prm.get_integer("Max nonlinear iterations");
+
+      prm.enter_subsection("Linear solver");
+      {
+        direct_solver         = prm.get("Type") == "direct";
+        linear_tolerance      = prm.get_double("Tolerance");
+        max_linear_iterations = prm.get_integer("Max iterations");
+        const std::string schur = prm.get("Schur complement");
+        schur_approximation =
+          schur == "pressure mass" ?
+            SchurApproximation::pressure_mass :
+            (schur == "pressure Laplacian" ? SchurApproximation::pressure_laplace :
+                                             SchurApproximation::cahouet_chabard);
+        velocity_amg_cycles = prm.get_integer("Velocity AMG cycles");
+      }
+      prm.leave_subsection();
+
+      std::shared_ptr<dealii::Functions::ParsedFunction<dim>> *targets[] = {
+        &fluid_fraction,
+        &drag_coefficient,
+        &grain_velocity,
+        &forcing,
+        &boundary_velocity,
+        &open_boundary_pressure,
+        &initial_velocity};
+      unsigned int i = 0;
+      for (const FieldEntry &f : field_entries)
+        {
+          prm.enter_subsection(f.name);
+          auto function = std::make_shared<dealii::Functions::ParsedFunction<dim>>(
+            f.vector_valued ? dim : 1);
+          try
+            {
+              function->parse_parameters(prm);
+            }
+          catch (const std::exception &e)
+            {
+              std::string message = e.what();
+              if (const auto *d = dynamic_cast<const dealii::ExceptionBase *>(&e))
+                {
+                  std::ostringstream info;
+                  d->print_info(info);
+                  message = info.str();
+                }
+              where.fail(std::string(f.name) + "/Function expression",
+                         prm.get("Function expression"),
+                         message);
+            }
+          *targets[i++] = function;
+          prm.leave_subsection();
+        }
+    }
+    prm.leave_subsection();
+
+    if (!enabled)
+      return;
+
+    // A fluid fraction outside (0,1] is a modelling error that would only
+    // show as a failing solver later: sample it on a grid over the box now,
+    // before anything is written.
+    const unsigned int n = 16;
+    for (unsigned int k = 0; k < dealii::Utilities::fixed_power<dim>(n + 1); ++k)
+      {
+        dealii::Point<dim> p;
+        unsigned int       index = k;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double s = (index % (n + 1)) / double(n);
+            index /= (n + 1);
+            p[d] = geometry.lower_corner[d] +
+                   s * (geometry.upper_corner[d] - geometry.lower_corner[d]);
+          }
+        const double phi = fluid_fraction->value(p);
+        if (!(phi > 0 && phi <= 1))
+          {
+            std::ostringstream value;
+            value << "phi(" << p << ") = " << phi;
+            where.fail("Fluid fraction/Function expression",
+                       value.str(),
+                       "the fluid fraction must lie in (0,1]");
+          }
+        const double beta = drag_coefficient->value(p);
+        if (!(beta >= 0))
+          {
+            std::ostringstream value;
+            value << "beta(" << p << ") = " << beta;
+            where.fail("Drag coefficient/Function expression",
+                       value.str(),
+                       "the drag coefficient must be non-negative");
+          }
+      }
+  }
+
+
+  template struct FluidParameters<2>;
+  template struct FluidParameters<3>;
+} // namespace ImmersedGrains

@@ -1,0 +1,598 @@
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_renumbering.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+#include <deal.II/numerics/data_postprocessor.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <immersed_grains/fluid/block_preconditioner.h>
+#include <immersed_grains/fluid/fluid_solver.h>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    // A velocity function as the first dim components of a (u, p) field.
+    template <int dim>
+    class VelocityOfSystem : public dealii::Function<dim>
+    {
+    public:
+      explicit VelocityOfSystem(const dealii::Function<dim> &velocity)
+        : dealii::Function<dim>(dim + 1)
+        , velocity(velocity)
+      {}
+
+      double
+      value(const dealii::Point<dim> &p, const unsigned int c) const override
+      {
+        return c < dim ? velocity.value(p, c) : 0.0;
+      }
+
+    private:
+      const dealii::Function<dim> &velocity;
+    };
+
+
+    // Evaluates the mixture fields at output points, so that what is written
+    // is what the solver used.
+    template <int dim>
+    class MixtureFieldsOutput : public dealii::DataPostprocessor<dim>
+    {
+    public:
+      MixtureFieldsOutput(const MixtureFields<dim> &fields, const double time)
+        : fields(fields)
+        , time(time)
+      {}
+
+      void
+      evaluate_vector_field(
+        const dealii::DataPostprocessorInputs::Vector<dim> &inputs,
+        std::vector<dealii::Vector<double>> &computed) const override
+      {
+        const auto cell =
+          inputs.template get_cell<dim>();
+        MixtureValues<dim> values;
+        fields.evaluate(cell, inputs.evaluation_points, time, values);
+        for (unsigned int q = 0; q < computed.size(); ++q)
+          {
+            computed[q](0) = values.fluid_fraction[q];
+            computed[q](1) = values.drag_coefficient[q];
+          }
+      }
+
+      std::vector<std::string>
+      get_names() const override
+      {
+        return {"fluid_fraction", "drag_coefficient"};
+      }
+
+      dealii::UpdateFlags
+      get_needed_update_flags() const override
+      {
+        return dealii::update_quadrature_points;
+      }
+
+    private:
+      const MixtureFields<dim> &fields;
+      const double              time;
+    };
+  } // namespace
+
+
+  template <int dim>
+  FluidSolver<dim>::FluidSolver(
+    const FluidParameters<dim>                        &parameters,
+    const Geometry<dim>                               &geometry,
+    dealii::parallel::distributed::Triangulation<dim> &triangulation,
+    dealii::TimerOutput                               &timer,
+    dealii::ConditionalOStream                        &pcout)
+    : parameters(parameters)
+    , geometry(geometry)
+    , triangulation(triangulation)
+    , timer(timer)
+    , pcout(pcout)
+    , mpi_communicator(triangulation.get_communicator())
+    , fe(dealii::FE_Q<dim>(2), dim, dealii::FE_Q<dim>(1), 1)
+    , dof_handler(triangulation)
+    , forcing(parameters.forcing)
+    , boundary_velocity(parameters.boundary_velocity)
+  {
+    mixture_fields = std::make_shared<PrescribedMixtureFields<dim>>(
+      parameters.fluid_fraction,
+      parameters.drag_coefficient,
+      parameters.grain_velocity);
+  }
+
+
+  template <int dim>
+  FluidSolver<dim>::~FluidSolver() = default;
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::set_mixture_fields(
+    std::shared_ptr<const MixtureFields<dim>> fields)
+  {
+    mixture_fields = fields;
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::set_forcing(std::shared_ptr<dealii::Function<dim>> f)
+  {
+    forcing = f;
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::set_boundary_velocity(
+    std::shared_ptr<dealii::Function<dim>> velocity)
+  {
+    boundary_velocity = velocity;
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::setup_dofs()
+  {
+    dealii::TimerOutput::Scope scope(timer, "fluid: setup");
+
+    dof_handler.distribute_dofs(fe);
+    dealii::DoFRenumbering::Cuthill_McKee(dof_handler);
+    std::vector<unsigned int> block_component(dim + 1, 0);
+    block_component[dim] = 1;
+    dealii::DoFRenumbering::component_wise(dof_handler, block_component);
+
+    const auto dofs_per_block =
+      dealii::DoFTools::count_dofs_per_fe_block(dof_handler, block_component);
+    const auto n_u = dofs_per_block[0], n_p = dofs_per_block[1];
+
+    const dealii::IndexSet owned = dof_handler.locally_owned_dofs();
+    dealii::IndexSet       relevant;
+    dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+    owned_partitioning    = {owned.get_view(0, n_u),
+                             owned.get_view(n_u, n_u + n_p)};
+    relevant_partitioning = {relevant.get_view(0, n_u),
+                             relevant.get_view(n_u, n_u + n_p)};
+
+    make_constraints();
+
+    {
+      dealii::Table<2, dealii::DoFTools::Coupling> coupling(dim + 1, dim + 1);
+      for (unsigned int c = 0; c < dim + 1; ++c)
+        for (unsigned int d = 0; d < dim + 1; ++d)
+          coupling[c][d] = (c == dim && d == dim) ? dealii::DoFTools::none :
+                                                    dealii::DoFTools::always;
+      dealii::TrilinosWrappers::BlockSparsityPattern sp(owned_partitioning,
+                                                        owned_partitioning,
+                                                        relevant_partitioning,
+                                                        mpi_communicator);
+      dealii::DoFTools::make_sparsity_pattern(
+        dof_handler,
+        coupling,
+        sp,
+        update_constraints,
+        false,
+        dealii::Utilities::MPI::this_mpi_process(mpi_communicator));
+      sp.compress();
+      system_matrix.reinit(sp);
+    }
+    {
+      dealii::Table<2, dealii::DoFTools::Coupling> coupling(dim + 1, dim + 1);
+      for (unsigned int c = 0; c < dim + 1; ++c)
+        for (unsigned int d = 0; d < dim + 1; ++d)
+          coupling[c][d] = (c == dim && d == dim) ? dealii::DoFTools::always :
+                                                    dealii::DoFTools::none;
+      // Each matrix is built with the constraints it is assembled with.
+      for (auto *matrix : {&pressure_mass_matrix, &pressure_laplace_matrix})
+        {
+          dealii::TrilinosWrappers::BlockSparsityPattern sp(
+            owned_partitioning,
+            owned_partitioning,
+            relevant_partitioning,
+            mpi_communicator);
+          dealii::DoFTools::make_sparsity_pattern(
+            dof_handler,
+            coupling,
+            sp,
+            matrix == &pressure_mass_matrix ? pressure_mass_constraints :
+                                              pressure_laplace_constraints,
+            false,
+            dealii::Utilities::MPI::this_mpi_process(mpi_communicator));
+          sp.compress();
+          matrix->reinit(sp);
+        }
+    }
+
+    solution.reinit(owned_partitioning, relevant_partitioning, mpi_communicator);
+    old_solution.reinit(solution);
+    old_old_solution.reinit(solution);
+    system_rhs.reinit(owned_partitioning, mpi_communicator);
+    newton_update.reinit(owned_partitioning, mpi_communicator);
+    preconditioner.reset();
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::make_constraints()
+  {
+    dealii::IndexSet relevant;
+    dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    const dealii::FEValuesExtractors::Scalar pressure(dim);
+    const auto velocity_mask = fe.component_mask(velocities);
+
+    std::set<dealii::types::boundary_id> slip_faces;
+    for (unsigned int f = 0; f < 2 * dim; ++f)
+      if (geometry.boundary_types[f] == BoundaryType::slip)
+        slip_faces.insert(f);
+
+    boundary_velocity->set_time(time);
+    const VelocityOfSystem<dim>               prescribed(*boundary_velocity);
+    const dealii::Functions::ZeroFunction<dim> zero(dim + 1);
+
+    // Same structure, two right-hand sides: the solution carries the
+    // boundary data, the update is zero wherever the solution is fixed.
+    for (const bool homogeneous : {false, true})
+      {
+        auto &c = homogeneous ? update_constraints : solution_constraints;
+        c.clear();
+        c.reinit(relevant);
+        dealii::DoFTools::make_hanging_node_constraints(dof_handler, c);
+        for (unsigned int d = 0; d < dim; ++d)
+          if (geometry.is_periodic(d))
+            dealii::DoFTools::make_periodicity_constraints(
+              dof_handler, 2 * d, 2 * d + 1, d, c);
+        for (unsigned int f = 0; f < 2 * dim; ++f)
+          {
+            if (geometry.boundary_types[f] == BoundaryType::wall)
+              dealii::VectorTools::interpolate_boundary_values(
+                mapping, dof_handler, f, zero, c, velocity_mask);
+            else if (geometry.boundary_types[f] == BoundaryType::velocity)
+              dealii::VectorTools::interpolate_boundary_values(
+                mapping,
+                dof_handler,
+                f,
+                homogeneous ? static_cast<const dealii::Function<dim> &>(zero) :
+                              prescribed,
+                c,
+                velocity_mask);
+          }
+        if (!slip_faces.empty())
+          dealii::VectorTools::compute_no_normal_flux_constraints(
+            dof_handler, 0, slip_faces, c, mapping);
+        c.close();
+      }
+
+    for (auto *c : {&pressure_mass_constraints, &pressure_laplace_constraints})
+      {
+        c->clear();
+        c->reinit(relevant);
+        dealii::DoFTools::make_hanging_node_constraints(dof_handler, *c);
+        for (unsigned int d = 0; d < dim; ++d)
+          if (geometry.is_periodic(d))
+            dealii::DoFTools::make_periodicity_constraints(
+              dof_handler, 2 * d, 2 * d + 1, d, *c);
+      }
+    pressure_mass_constraints.close();
+    // Where the pressure is imposed, the Schur complement of the
+    // mass/drag-dominated limit is a Laplacian with Dirichlet data.
+    for (unsigned int f = 0; f < 2 * dim; ++f)
+      if (geometry.boundary_types[f] == BoundaryType::open)
+        dealii::VectorTools::interpolate_boundary_values(
+          mapping, dof_handler, f, zero, pressure_laplace_constraints,
+          fe.component_mask(pressure));
+    pressure_laplace_constraints.close();
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::set_initial_condition()
+  {
+    VectorType owned(owned_partitioning, mpi_communicator);
+    parameters.initial_velocity->set_time(0);
+    dealii::VectorTools::interpolate(mapping,
+                                     dof_handler,
+                                     VelocityOfSystem<dim>(
+                                       *parameters.initial_velocity),
+                                     owned);
+    solution_constraints.distribute(owned);
+    solution         = owned;
+    old_solution     = solution;
+    old_old_solution = solution;
+    time             = 0;
+    steps_done       = 0;
+  }
+
+
+  template <int dim>
+  bool
+  FluidSolver<dim>::pressure_has_null_space() const
+  {
+    return !geometry.has_open_boundary();
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::normalize_pressure(VectorType &vector) const
+  {
+    if (!pressure_has_null_space())
+      return;
+    VectorType ghosted(owned_partitioning, relevant_partitioning, mpi_communicator);
+    ghosted = vector;
+    const double mean = dealii::VectorTools::compute_mean_value(
+      mapping, dof_handler, dealii::QGauss<dim>(3), ghosted, dim);
+    vector.block(1).add(-mean);
+  }
+
+
+  template <int dim>
+  typename FluidSolver<dim>::StepStatistics
+  FluidSolver<dim>::solve_time_step(const double new_time, const double step)
+  {
+    old_dt = dt;
+    dt     = step;
+    time   = new_time;
+
+    // BDF weights for (u^{n+1}, u^n, u^{n-1}) / dt, variable step for BDF2.
+    const bool   second_order = parameters.bdf_order == 2 && steps_done > 0;
+    const double omega        = second_order ? dt / old_dt : 0.0;
+    if (!parameters.time_derivative)
+      bdf = {{0, 0, 0}};
+    else if (second_order)
+      bdf = {{(1 + 2 * omega) / (1 + omega),
+              -(1 + omega),
+              omega * omega / (1 + omega)}};
+    else
+      bdf = {{1, -1, 0}};
+
+    old_old_solution = old_solution;
+    old_solution     = solution;
+
+    // Start from the extrapolated state and the new boundary data.
+    {
+      dealii::TimerOutput::Scope scope(timer, "fluid: setup");
+      make_constraints();
+    }
+    VectorType iterate(owned_partitioning, mpi_communicator);
+    iterate = old_solution;
+    if (second_order && parameters.time_derivative)
+      {
+        iterate *= (1 + omega);
+        VectorType older(owned_partitioning, mpi_communicator);
+        older = old_old_solution;
+        iterate.add(-omega, older);
+      }
+    solution_constraints.distribute(iterate);
+    solution = iterate;
+
+    StepStatistics stats;
+    const bool     linear = !parameters.advection;
+    for (unsigned int k = 0; k < parameters.max_nonlinear_iterations; ++k)
+      {
+        assemble_system(true);
+        const double residual = system_rhs.l2_norm();
+        if (k == 0)
+          stats.initial_residual = residual;
+        stats.final_residual = residual;
+        if (k > 0 && residual <= parameters.nonlinear_tolerance *
+                                    std::max(stats.initial_residual, 1e-300))
+          break;
+        if (residual == 0)
+          break;
+
+        stats.linear_iterations += solve_linear_system();
+        ++stats.nonlinear_iterations;
+        update_constraints.distribute(newton_update);
+        iterate.add(1.0, newton_update);
+        solution = iterate;
+        if (linear)
+          break;
+      }
+    AssertThrow(linear || stats.nonlinear_iterations <
+                            parameters.max_nonlinear_iterations ||
+                  stats.final_residual <=
+                    parameters.nonlinear_tolerance * stats.initial_residual,
+                dealii::ExcMessage(
+                  "Fluid: the nonlinear iteration did not converge in " +
+                  std::to_string(parameters.max_nonlinear_iterations) +
+                  " iterations (Fluid/Max nonlinear iterations); reduce the "
+                  "time step or use Linearization = Newton."));
+
+    normalize_pressure(iterate);
+    solution = iterate;
+    ++steps_done;
+    return stats;
+  }
+
+
+  template <int dim>
+  std::array<double, 3>
+  FluidSolver<dim>::compute_errors(
+    const dealii::Function<dim> &exact_solution) const
+  {
+    const dealii::QGauss<dim> quadrature(fe.degree + 3);
+
+    // Pressure is compared up to its mean when the problem fixes it only
+    // up to a constant: shift the exact one onto the discrete mean.
+    double exact_mean = 0, volume = 0;
+    {
+      dealii::FEValues<dim> fe_values(mapping,
+                                      fe,
+                                      quadrature,
+                                      dealii::update_quadrature_points |
+                                        dealii::update_JxW_values);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            fe_values.reinit(cell);
+            for (unsigned int q = 0; q < quadrature.size(); ++q)
+              {
+                exact_mean += exact_solution.value(
+                                fe_values.quadrature_point(q), dim) *
+                              fe_values.JxW(q);
+                volume += fe_values.JxW(q);
+              }
+          }
+      exact_mean = dealii::Utilities::MPI::sum(exact_mean, mpi_communicator);
+      volume     = dealii::Utilities::MPI::sum(volume, mpi_communicator);
+      exact_mean /= volume;
+    }
+    const double discrete_mean = dealii::VectorTools::compute_mean_value(
+      mapping, dof_handler, quadrature, solution, dim);
+
+    class Shifted : public dealii::Function<dim>
+    {
+    public:
+      Shifted(const dealii::Function<dim> &f, const double shift)
+        : dealii::Function<dim>(dim + 1)
+        , f(f)
+        , shift(shift)
+      {}
+      double
+      value(const dealii::Point<dim> &p, const unsigned int c) const override
+      {
+        return f.value(p, c) + (c == dim ? shift : 0.0);
+      }
+      dealii::Tensor<1, dim>
+      gradient(const dealii::Point<dim> &p, const unsigned int c) const override
+      {
+        return f.gradient(p, c);
+      }
+
+    private:
+      const dealii::Function<dim> &f;
+      const double                 shift;
+    } shifted(exact_solution, discrete_mean - exact_mean);
+
+    const dealii::ComponentSelectFunction<dim> velocity_mask(
+      std::make_pair(0, dim), dim + 1);
+    const dealii::ComponentSelectFunction<dim> pressure_mask(dim, dim + 1);
+
+    dealii::Vector<float> cellwise(triangulation.n_active_cells());
+    std::array<double, 3> errors;
+    dealii::VectorTools::integrate_difference(mapping,
+                                              dof_handler,
+                                              solution,
+                                              shifted,
+                                              cellwise,
+                                              quadrature,
+                                              dealii::VectorTools::L2_norm,
+                                              &velocity_mask);
+    errors[0] = dealii::VectorTools::compute_global_error(
+      triangulation, cellwise, dealii::VectorTools::L2_norm);
+    dealii::VectorTools::integrate_difference(mapping,
+                                              dof_handler,
+                                              solution,
+                                              shifted,
+                                              cellwise,
+                                              quadrature,
+                                              dealii::VectorTools::H1_seminorm,
+                                              &velocity_mask);
+    errors[1] = dealii::VectorTools::compute_global_error(
+      triangulation, cellwise, dealii::VectorTools::H1_seminorm);
+    dealii::VectorTools::integrate_difference(mapping,
+                                              dof_handler,
+                                              solution,
+                                              shifted,
+                                              cellwise,
+                                              quadrature,
+                                              dealii::VectorTools::L2_norm,
+                                              &pressure_mask);
+    errors[2] = dealii::VectorTools::compute_global_error(
+      triangulation, cellwise, dealii::VectorTools::L2_norm);
+    return errors;
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::add_data_vectors(dealii::DataOut<dim> &data_out) const
+  {
+    std::vector<std::string> names(dim, "velocity");
+    names.emplace_back("pressure");
+    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+      interpretation(dim,
+                     dealii::DataComponentInterpretation::component_is_part_of_vector);
+    interpretation.push_back(dealii::DataComponentInterpretation::component_is_scalar);
+    data_out.add_data_vector(dof_handler,
+                             solution,
+                             names,
+                             interpretation);
+    output_fields =
+      std::make_unique<MixtureFieldsOutput<dim>>(*mixture_fields, time);
+    data_out.add_data_vector(dof_handler, solution, *output_fields);
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::integrate_fluid_fraction() const
+  {
+    const dealii::QGauss<dim> quadrature(3);
+    dealii::FEValues<dim>     fe_values(mapping,
+                                    fe,
+                                    quadrature,
+                                    dealii::update_quadrature_points |
+                                      dealii::update_JxW_values);
+    MixtureValues<dim>        values;
+    double                    integral = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          mixture_fields->evaluate(cell,
+                                   fe_values.get_quadrature_points(),
+                                   time,
+                                   values);
+          for (unsigned int q = 0; q < quadrature.size(); ++q)
+            integral += values.fluid_fraction[q] * fe_values.JxW(q);
+        }
+    return dealii::Utilities::MPI::sum(integral, mpi_communicator);
+  }
+
+
+  template <int dim>
+  dealii::types::global_dof_index
+  FluidSolver<dim>::n_dofs() const
+  {
+    return dof_handler.n_dofs();
+  }
+
+
+  template <int dim>
+  const dealii::DoFHandler<dim> &
+  FluidSolver<dim>::get_dof_handler() const
+  {
+    return dof_handler;
+  }
+
+
+  template <int dim>
+  const typename FluidSolver<dim>::VectorType &
+  FluidSolver<dim>::get_solution() const
+  {
+    return solution;
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::get_time() const
+  {
+    return time;
+  }
+
+
+  template class FluidSolver<2>;
+  template class FluidSolver<3>;
+} // namespace ImmersedGrains

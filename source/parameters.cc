@@ -1,0 +1,197 @@
+#include <deal.II/base/exceptions.h>
+#include <deal.II/base/utilities.h>
+
+#include <immersed_grains/parameters.h>
+
+#include <fstream>
+#include <sstream>
+
+namespace ImmersedGrains
+{
+  std::string
+  one_line(const std::string &text)
+  {
+    std::string result;
+    bool        in_space = true;
+    for (const char c : text)
+      {
+        if (std::isspace(static_cast<unsigned char>(c)))
+          {
+            if (!in_space)
+              result += ' ';
+            in_space = true;
+          }
+        else
+          {
+            result += c;
+            in_space = false;
+          }
+      }
+    while (!result.empty() && result.back() == ' ')
+      result.pop_back();
+    return result;
+  }
+
+
+  InputError::InputError(const std::string &file,
+                         const std::string &parameter,
+                         const std::string &value,
+                         const std::string &problem)
+    : std::runtime_error(one_line(file + ": parameter '" + parameter +
+                                  "' = '" + value + "': " + problem))
+  {}
+
+
+  void
+  InputLocation::fail(const std::string &parameter,
+                      const std::string &value,
+                      const std::string &problem) const
+  {
+    throw InputError(file,
+                     section.empty() ? parameter : section + "/" + parameter,
+                     value,
+                     problem);
+  }
+
+
+  void
+  InputLocation::require(const bool         condition,
+                         const std::string &parameter,
+                         const std::string &value,
+                         const std::string &problem) const
+  {
+    if (!condition)
+      fail(parameter, value, problem);
+  }
+
+
+  unsigned int
+  read_dimension(const std::string &file)
+  {
+    std::ifstream in(file);
+    if (!in)
+      throw InputError(file, "(file)", file, "cannot open the parameter file");
+
+    // Only the top level counts: a "set Dimension" inside a subsection
+    // would be an error that ParameterHandler reports later.
+    int         depth = 0;
+    std::string line;
+    while (std::getline(in, line))
+      {
+        const auto hash = line.find('#');
+        if (hash != std::string::npos)
+          line.erase(hash);
+        std::istringstream words(line);
+        std::string        first;
+        words >> first;
+        if (first == "subsection")
+          ++depth;
+        else if (first == "end")
+          --depth;
+        else if (first == "set" && depth == 0)
+          {
+            std::string rest;
+            std::getline(words, rest);
+            const auto eq = rest.find('=');
+            if (eq == std::string::npos)
+              continue;
+            if (dealii::Utilities::trim(rest.substr(0, eq)) != "Dimension")
+              continue;
+            const std::string value =
+              dealii::Utilities::trim(rest.substr(eq + 1));
+            if (value == "2")
+              return 2;
+            if (value == "3")
+              return 3;
+            throw InputError(file, "Dimension", value, "must be 2 or 3");
+          }
+      }
+    return 2;
+  }
+
+
+  void
+  parse_parameter_file(dealii::ParameterHandler &prm, const std::string &file)
+  {
+    std::ifstream in(file);
+    if (!in)
+      throw InputError(file, "(file)", file, "cannot open the parameter file");
+    try
+      {
+        prm.parse_input(in, file);
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        std::ostringstream info;
+        e.print_info(info);
+        throw std::runtime_error(one_line(file + ": " + info.str()));
+      }
+  }
+
+
+  std::vector<double>
+  parse_double_list(const std::string   &text,
+                    const InputLocation &where,
+                    const std::string   &parameter,
+                    const unsigned int   n)
+  {
+    std::vector<double> values;
+    for (const std::string &entry : dealii::Utilities::split_string_list(text))
+      {
+        std::istringstream in(entry);
+        double             v;
+        std::string        trailing;
+        if (!(in >> v) || (in >> trailing))
+          where.fail(parameter, text, "'" + entry + "' is not a number");
+        values.push_back(v);
+      }
+    if (n != 0 && values.size() != n)
+      where.fail(parameter,
+                 text,
+                 "expected " + std::to_string(n) + " comma-separated values");
+    return values;
+  }
+
+
+  template <int dim>
+  dealii::Point<dim>
+  parse_point(const std::string   &text,
+              const InputLocation &where,
+              const std::string   &parameter)
+  {
+    const auto         values = parse_double_list(text, where, parameter, dim);
+    dealii::Point<dim> p;
+    for (unsigned int d = 0; d < dim; ++d)
+      p[d] = values[d];
+    return p;
+  }
+
+
+  template <int dim>
+  std::vector<dealii::Point<dim>>
+  parse_point_list(const std::string   &text,
+                   const InputLocation &where,
+                   const std::string   &parameter)
+  {
+    std::vector<dealii::Point<dim>> points;
+    for (const std::string &entry :
+         dealii::Utilities::split_string_list(text, ';'))
+      if (!entry.empty())
+        points.push_back(parse_point<dim>(entry, where, parameter));
+    return points;
+  }
+
+
+  template dealii::Point<2>
+  parse_point<2>(const std::string &, const InputLocation &, const std::string &);
+  template dealii::Point<3>
+  parse_point<3>(const std::string &, const InputLocation &, const std::string &);
+  template std::vector<dealii::Point<2>>
+  parse_point_list<2>(const std::string &,
+                      const InputLocation &,
+                      const std::string &);
+  template std::vector<dealii::Point<3>>
+  parse_point_list<3>(const std::string &,
+                      const InputLocation &,
+                      const std::string &);
+} // namespace ImmersedGrains

@@ -1,0 +1,297 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/io/field_output.h>
+#include <immersed_grains/simulation.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    double
+    now()
+    {
+      return std::chrono::duration<double>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+    }
+
+    // The statistics.csv columns: the interface contract first (DESIGN.md).
+    std::vector<std::string>
+    statistics_columns(const int dim)
+    {
+      std::vector<std::string> c = {"step", "time", "dt", "particles", "solid_volume"};
+      const char *axes[] = {"x", "y", "z"};
+      for (int d = 0; d < dim; ++d)
+        c.push_back(std::string("centroid_") + axes[d]);
+      for (int d = 0; d < dim; ++d)
+        c.push_back(std::string("mean_velocity_") + axes[d]);
+      for (const char *name : {"max_speed",
+                               "kinetic_energy",
+                               "max_overlap",
+                               "contacts",
+                               "contact_iterations",
+                               "fluid_iterations",
+                               "cells",
+                               "dofs",
+                               "wall_time",
+                               "fluid_nonlinear_iterations",
+                               "fluid_residual",
+                               "fluid_volume"})
+        c.emplace_back(name);
+      return c;
+    }
+  } // namespace
+
+
+  template <int dim>
+  void
+  Simulation<dim>::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii::Patterns;
+    prm.declare_entry("Dimension",
+                      "2",
+                      Integer(2, 3),
+                      "Space dimension of the scene: 2 (discs per unit depth) "
+                      "or 3 (spheres).");
+    prm.declare_entry("Output directory",
+                      "",
+                      Anything(),
+                      "Where statistics.csv, log.txt and fields go; empty: "
+                      "output/<parameter file name without .prm>.");
+    prm.declare_entry("End time", "1", Double(0), "Simulated time [s].");
+    prm.declare_entry("Time step", "0.01", Double(0), "Time step [s].");
+
+    prm.enter_subsection("Output");
+    {
+      prm.declare_entry("Write fields every",
+                        "0",
+                        Integer(0),
+                        "Write VTU/PVTU fields every this many steps (0: only "
+                        "the initial and the final state).");
+      prm.declare_entry("Terminal output",
+                        "normal",
+                        Selection("normal|quiet|test"),
+                        "normal: the log on screen; quiet: only errors; test: "
+                        "only the Test columns of each statistics row, with "
+                        "6 digits (for the test suite).");
+      prm.declare_entry("Test columns",
+                        "step, time, solid_volume",
+                        Anything(),
+                        "Statistics columns printed per step in test mode.");
+    }
+    prm.leave_subsection();
+
+    Geometry<dim>::declare_parameters(prm);
+    FluidParameters<dim>::declare_parameters(prm);
+  }
+
+
+  template <int dim>
+  Simulation<dim>::Simulation(dealii::ParameterHandler &prm,
+                              const std::string        &file,
+                              MPI_Comm                  comm)
+    : comm(comm)
+    , parameter_file(file)
+    , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+    , timer(comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times)
+    , statistics(statistics_columns(dim))
+    , triangulation(comm,
+                    dealii::Triangulation<dim>::maximum_smoothing,
+                    dealii::parallel::distributed::Triangulation<
+                      dim>::construct_multigrid_hierarchy)
+    , wall_start(now())
+  {
+    const InputLocation top{file, ""};
+    output_directory = prm.get("Output directory");
+    if (output_directory.empty())
+      output_directory =
+        "output/" + std::filesystem::path(file).stem().string();
+    end_time  = prm.get_double("End time");
+    time_step = prm.get_double("Time step");
+    top.require(time_step > 0, "Time step", prm.get("Time step"), "must be positive");
+
+    prm.enter_subsection("Output");
+    {
+      const InputLocation where{file, "Output"};
+      write_fields_every      = prm.get_integer("Write fields every");
+      const std::string mode  = prm.get("Terminal output");
+      test_output             = mode == "test";
+      quiet                   = mode != "normal";
+      test_columns = dealii::Utilities::split_string_list(prm.get("Test columns"));
+      for (const auto &c : test_columns)
+        where.require(statistics.has(c),
+                      "Test columns",
+                      prm.get("Test columns"),
+                      "no statistics column named '" + c + "'");
+    }
+    prm.leave_subsection();
+
+    geometry.parse_parameters(prm, file);
+    fluid_parameters.parse_parameters(prm, file, geometry);
+  }
+
+
+  template <int dim>
+  Simulation<dim>::~Simulation() = default;
+
+
+  template <int dim>
+  void
+  Simulation<dim>::prepare_output_directory()
+  {
+    const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
+    if (root)
+      {
+        std::error_code error;
+        std::filesystem::create_directories(output_directory, error);
+        AssertThrow(!error,
+                    dealii::ExcMessage("Cannot create the output directory '" +
+                                       output_directory + "': " +
+                                       error.message()));
+        std::filesystem::copy_file(
+          parameter_file,
+          output_directory + "/" +
+            std::filesystem::path(parameter_file).filename().string(),
+          std::filesystem::copy_options::overwrite_existing);
+      }
+    MPI_Barrier(comm);
+    log.open(output_directory + "/log.txt", root, !quiet);
+    statistics.open(output_directory + "/statistics.csv", root);
+    field_output = std::make_unique<FieldOutput<dim>>(output_directory, comm);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::setup()
+  {
+    {
+      dealii::TimerOutput::Scope scope(timer, "mesh");
+      geometry.create_mesh(triangulation);
+    }
+    pcout << "immersed-grains: " << dim << "D scene " << parameter_file
+          << " on " << dealii::Utilities::MPI::n_mpi_processes(comm)
+          << " MPI rank(s)\n"
+          << "  mesh: " << triangulation.n_global_active_cells()
+          << " cells, boundary conditions:";
+    for (const auto t : geometry.boundary_types)
+      pcout << ' ' << to_string(t);
+    pcout << '\n';
+
+    if (fluid_parameters.enabled)
+      {
+        fluid = std::make_unique<FluidSolver<dim>>(
+          fluid_parameters, geometry, triangulation, timer, pcout);
+        fluid->setup_dofs();
+        fluid->set_initial_condition();
+        pcout << "  fluid: "
+              << (fluid_parameters.advection ? "Navier-Stokes" : "Stokes")
+              << (fluid_parameters.time_derivative ?
+                    (fluid_parameters.bdf_order == 2 ? ", BDF2" : ", BDF1") :
+                    ", steady")
+              << ", Q2-Q1, " << fluid->n_dofs() << " DoFs, "
+              << (fluid_parameters.direct_solver ? "direct solver" :
+                                                   "FGMRES + block AMG")
+              << '\n';
+      }
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::run()
+  {
+    prepare_output_directory();
+    setup();
+    postprocess(0, 0);
+    maybe_write_fields(true);
+
+    // Steps end exactly on End time; a last short step is allowed.
+    while (time < end_time * (1 - 1e-12))
+      {
+        const double dt = std::min(time_step, end_time - time);
+        ++step;
+        solve_time_step(dt);
+        maybe_write_fields(time >= end_time * (1 - 1e-12));
+      }
+
+    pcout << "  done: " << step << " steps, wall time " << now() - wall_start
+          << " s\n";
+    timer.print_wall_time_statistics(comm);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::solve_time_step(const double dt)
+  {
+    unsigned int fluid_iterations = 0;
+    double       new_time         = time + dt;
+    if (fluid)
+      {
+        const auto stats = fluid->solve_time_step(new_time, dt);
+        fluid_iterations = stats.linear_iterations;
+        statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
+        statistics.set("fluid_residual", stats.final_residual);
+      }
+    time = new_time;
+    postprocess(dt, fluid_iterations);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::postprocess(const double dt, const unsigned int fluid_iterations)
+  {
+    dealii::TimerOutput::Scope scope(timer, "statistics");
+    statistics.set("step", step);
+    statistics.set("time", time);
+    statistics.set("dt", dt);
+    statistics.set("cells", triangulation.n_global_active_cells());
+    statistics.set("fluid_iterations", fluid_iterations);
+    if (fluid)
+      {
+        double volume = 1;
+        for (unsigned int d = 0; d < dim; ++d)
+          volume *= geometry.upper_corner[d] - geometry.lower_corner[d];
+        const double fluid_volume = fluid->integrate_fluid_fraction();
+        statistics.set("dofs", fluid->n_dofs());
+        statistics.set("fluid_volume", fluid_volume);
+        statistics.set("solid_volume", volume - fluid_volume);
+      }
+    statistics.set("wall_time", now() - wall_start);
+    statistics.write_row();
+
+    if (test_output && dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      statistics.print(std::cout, test_columns);
+    if (!quiet)
+      pcout << "step " << step << " t=" << time << " dt=" << dt
+            << " fluid iterations=" << fluid_iterations << '\n';
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::maybe_write_fields(const bool force)
+  {
+    if (!fluid)
+      return;
+    if (!force && (write_fields_every == 0 || step % write_fields_every != 0))
+      return;
+    dealii::TimerOutput::Scope scope(timer, "output");
+    field_output->write(triangulation, time, step, [this](dealii::DataOut<dim> &d) {
+      fluid->add_data_vectors(d);
+    });
+  }
+
+
+  template class Simulation<2>;
+  template class Simulation<3>;
+} // namespace ImmersedGrains
