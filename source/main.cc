@@ -15,7 +15,8 @@
 namespace
 {
   const char *usage =
-    "usage: immersed-grains SCENE.prm          run a scene (mpirun -np N works)\n"
+    "usage: immersed-grains SCENE.prm          run a scene (mpirun -np N "
+    "works)\n"
     "       immersed-grains --print-parameters [2|3]\n"
     "                                          every parameter, its default\n"
     "                                          and documentation\n"
@@ -47,7 +48,8 @@ int
 main(int argc, char **argv)
 {
   dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
+  const bool                               root =
+    dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   // deal.II would print a backtrace and abort on a failed AssertThrow in
   // some configurations; we want the message only.
   dealii::deal_II_exceptions::disable_abort_on_exception();
@@ -55,61 +57,61 @@ main(int argc, char **argv)
 
   const std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h")
-    {
-      if (root)
-        (args.empty() ? std::cerr : std::cout) << usage;
-      return args.empty() ? 1 : 0;
-    }
+  {
+    if (root)
+      (args.empty() ? std::cerr : std::cout) << usage;
+    return args.empty() ? 1 : 0;
+  }
 
   try
+  {
+    if (args[0] == "--print-parameters")
     {
-      if (args[0] == "--print-parameters")
-        {
-          const std::string dim = args.size() > 1 ? args[1] : "2";
-          if (dim != "2" && dim != "3")
-            throw std::runtime_error("--print-parameters takes 2 or 3, not '" +
-                                     dim + "'");
-          if (root)
-            (dim == "2" ? print_parameters<2>() : print_parameters<3>());
-          return 0;
-        }
-      if (args.size() != 1 || args[0].rfind("-", 0) == 0)
-        {
-          if (root)
-            std::cerr << usage;
-          return 1;
-        }
+      const std::string dim = args.size() > 1 ? args[1] : "2";
+      if (dim != "2" && dim != "3")
+        throw std::runtime_error("--print-parameters takes 2 or 3, not '" +
+                                 dim + "'");
+      if (root)
+        (dim == "2" ? print_parameters<2>() : print_parameters<3>());
+      return 0;
+    }
+    if (args.size() != 1 || args[0].rfind("-", 0) == 0)
+    {
+      if (root)
+        std::cerr << usage;
+      return 1;
+    }
 
-      const std::string  file = args[0];
-      const unsigned int dim  = ImmersedGrains::read_dimension(file);
-      if (dim == 2)
-        run_scene<2>(file);
-      else
-        run_scene<3>(file);
-    }
+    const std::string  file = args[0];
+    const unsigned int dim  = ImmersedGrains::read_dimension(file);
+    if (dim == 2)
+      run_scene<2>(file);
+    else
+      run_scene<3>(file);
+  }
   catch (const ImmersedGrains::InputError &e)
-    {
-      if (root)
-        std::cerr << "immersed-grains: error: " << e.what() << std::endl;
-      return 1;
-    }
+  {
+    if (root)
+      std::cerr << "immersed-grains: error: " << e.what() << std::endl;
+    return 1;
+  }
   catch (const dealii::ExceptionBase &e)
-    {
-      std::ostringstream info;
-      e.print_info(info);
-      std::cerr << "immersed-grains: error: "
-                << ImmersedGrains::one_line(info.str()) << std::endl;
-      if (dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) > 1)
-        MPI_Abort(MPI_COMM_WORLD, 2);
-      return 2;
-    }
+  {
+    std::ostringstream info;
+    e.print_info(info);
+    std::cerr << "immersed-grains: error: "
+              << ImmersedGrains::one_line(info.str()) << std::endl;
+    if (dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) > 1)
+      MPI_Abort(MPI_COMM_WORLD, 2);
+    return 2;
+  }
   catch (const std::exception &e)
-    {
-      // Parse errors are raised on every rank alike: print once.
-      if (root)
-        std::cerr << "immersed-grains: error: "
-                  << ImmersedGrains::one_line(e.what()) << std::endl;
-      return 1;
-    }
+  {
+    // Parse errors are raised on every rank alike: print once.
+    if (root)
+      std::cerr << "immersed-grains: error: "
+                << ImmersedGrains::one_line(e.what()) << std::endl;
+    return 1;
+  }
   return 0;
 }

@@ -14,19 +14,19 @@ namespace ImmersedGrains
     std::string result;
     bool        in_space = true;
     for (const char c : text)
+    {
+      if (std::isspace(static_cast<unsigned char>(c)))
       {
-        if (std::isspace(static_cast<unsigned char>(c)))
-          {
-            if (!in_space)
-              result += ' ';
-            in_space = true;
-          }
-        else
-          {
-            result += c;
-            in_space = false;
-          }
+        if (!in_space)
+          result += ' ';
+        in_space = true;
       }
+      else
+      {
+        result += c;
+        in_space = false;
+      }
+    }
     while (!result.empty() && result.back() == ' ')
       result.pop_back();
     return result;
@@ -37,9 +37,10 @@ namespace ImmersedGrains
                          const std::string &parameter,
                          const std::string &value,
                          const std::string &problem)
-    : std::runtime_error(one_line(file + ": parameter '" + parameter +
-                                  "' = '" + value + "': " + problem))
-  {}
+      : std::runtime_error(one_line(file + ": parameter '" + parameter +
+                                    "' = '" + value + "': " + problem))
+  {
+  }
 
 
   void
@@ -77,35 +78,34 @@ namespace ImmersedGrains
     int         depth = 0;
     std::string line;
     while (std::getline(in, line))
+    {
+      const auto hash = line.find('#');
+      if (hash != std::string::npos)
+        line.erase(hash);
+      std::istringstream words(line);
+      std::string        first;
+      words >> first;
+      if (first == "subsection")
+        ++depth;
+      else if (first == "end")
+        --depth;
+      else if (first == "set" && depth == 0)
       {
-        const auto hash = line.find('#');
-        if (hash != std::string::npos)
-          line.erase(hash);
-        std::istringstream words(line);
-        std::string        first;
-        words >> first;
-        if (first == "subsection")
-          ++depth;
-        else if (first == "end")
-          --depth;
-        else if (first == "set" && depth == 0)
-          {
-            std::string rest;
-            std::getline(words, rest);
-            const auto eq = rest.find('=');
-            if (eq == std::string::npos)
-              continue;
-            if (dealii::Utilities::trim(rest.substr(0, eq)) != "Dimension")
-              continue;
-            const std::string value =
-              dealii::Utilities::trim(rest.substr(eq + 1));
-            if (value == "2")
-              return 2;
-            if (value == "3")
-              return 3;
-            throw InputError(file, "Dimension", value, "must be 2 or 3");
-          }
+        std::string rest;
+        std::getline(words, rest);
+        const auto eq = rest.find('=');
+        if (eq == std::string::npos)
+          continue;
+        if (dealii::Utilities::trim(rest.substr(0, eq)) != "Dimension")
+          continue;
+        const std::string value = dealii::Utilities::trim(rest.substr(eq + 1));
+        if (value == "2")
+          return 2;
+        if (value == "3")
+          return 3;
+        throw InputError(file, "Dimension", value, "must be 2 or 3");
       }
+    }
     return 2;
   }
 
@@ -117,15 +117,15 @@ namespace ImmersedGrains
     if (!in)
       throw InputError(file, "(file)", file, "cannot open the parameter file");
     try
-      {
-        prm.parse_input(in, file);
-      }
+    {
+      prm.parse_input(in, file);
+    }
     catch (const dealii::ExceptionBase &e)
-      {
-        std::ostringstream info;
-        e.print_info(info);
-        throw std::runtime_error(one_line(file + ": " + info.str()));
-      }
+    {
+      std::ostringstream info;
+      e.print_info(info);
+      throw std::runtime_error(one_line(file + ": " + info.str()));
+    }
   }
 
 
@@ -137,14 +137,14 @@ namespace ImmersedGrains
   {
     std::vector<double> values;
     for (const std::string &entry : dealii::Utilities::split_string_list(text))
-      {
-        std::istringstream in(entry);
-        double             v;
-        std::string        trailing;
-        if (!(in >> v) || (in >> trailing))
-          where.fail(parameter, text, "'" + entry + "' is not a number");
-        values.push_back(v);
-      }
+    {
+      std::istringstream in(entry);
+      double             v;
+      std::string        trailing;
+      if (!(in >> v) || (in >> trailing))
+        where.fail(parameter, text, "'" + entry + "' is not a number");
+      values.push_back(v);
+    }
     if (n != 0 && values.size() != n)
       where.fail(parameter,
                  text,
@@ -183,9 +183,13 @@ namespace ImmersedGrains
 
 
   template dealii::Point<2>
-  parse_point<2>(const std::string &, const InputLocation &, const std::string &);
+  parse_point<2>(const std::string &,
+                 const InputLocation &,
+                 const std::string &);
   template dealii::Point<3>
-  parse_point<3>(const std::string &, const InputLocation &, const std::string &);
+  parse_point<3>(const std::string &,
+                 const InputLocation &,
+                 const std::string &);
   template std::vector<dealii::Point<2>>
   parse_point_list<2>(const std::string &,
                       const InputLocation &,

@@ -26,7 +26,8 @@ namespace ImmersedGrains
     std::vector<std::string>
     statistics_columns(const int dim)
     {
-      std::vector<std::string> c = {"step", "time", "dt", "particles", "solid_volume"};
+      std::vector<std::string> c = {
+        "step", "time", "dt", "particles", "solid_volume"};
       const char *axes[] = {"x", "y", "z"};
       for (int d = 0; d < dim; ++d)
         c.push_back(std::string("centroid_") + axes[d]);
@@ -97,16 +98,15 @@ namespace ImmersedGrains
   Simulation<dim>::Simulation(dealii::ParameterHandler &prm,
                               const std::string        &file,
                               MPI_Comm                  comm)
-    : comm(comm)
-    , parameter_file(file)
-    , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-    , timer(comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times)
-    , statistics(statistics_columns(dim))
-    , triangulation(comm,
-                    dealii::Triangulation<dim>::maximum_smoothing,
-                    dealii::parallel::distributed::Triangulation<
-                      dim>::construct_multigrid_hierarchy)
-    , wall_start(now())
+      : comm(comm)
+      , parameter_file(file)
+      , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      , statistics(statistics_columns(dim))
+      , triangulation(comm,
+                      dealii::Triangulation<dim>::maximum_smoothing,
+                      dealii::parallel::distributed::Triangulation<
+                        dim>::construct_multigrid_hierarchy)
+      , wall_start(now())
   {
     const InputLocation top{file, ""};
     output_directory = prm.get("Output directory");
@@ -115,16 +115,20 @@ namespace ImmersedGrains
         "output/" + std::filesystem::path(file).stem().string();
     end_time  = prm.get_double("End time");
     time_step = prm.get_double("Time step");
-    top.require(time_step > 0, "Time step", prm.get("Time step"), "must be positive");
+    top.require(time_step > 0,
+                "Time step",
+                prm.get("Time step"),
+                "must be positive");
 
     prm.enter_subsection("Output");
     {
       const InputLocation where{file, "Output"};
-      write_fields_every      = prm.get_integer("Write fields every");
-      const std::string mode  = prm.get("Terminal output");
-      test_output             = mode == "test";
-      quiet                   = mode != "normal";
-      test_columns = dealii::Utilities::split_string_list(prm.get("Test columns"));
+      write_fields_every     = prm.get_integer("Write fields every");
+      const std::string mode = prm.get("Terminal output");
+      test_output            = mode == "test";
+      quiet                  = mode != "normal";
+      test_columns =
+        dealii::Utilities::split_string_list(prm.get("Test columns"));
       for (const auto &c : test_columns)
         where.require(statistics.has(c),
                       "Test columns",
@@ -148,19 +152,19 @@ namespace ImmersedGrains
   {
     const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
     if (root)
-      {
-        std::error_code error;
-        std::filesystem::create_directories(output_directory, error);
-        AssertThrow(!error,
-                    dealii::ExcMessage("Cannot create the output directory '" +
-                                       output_directory + "': " +
-                                       error.message()));
-        std::filesystem::copy_file(
-          parameter_file,
-          output_directory + "/" +
-            std::filesystem::path(parameter_file).filename().string(),
-          std::filesystem::copy_options::overwrite_existing);
-      }
+    {
+      std::error_code error;
+      std::filesystem::create_directories(output_directory, error);
+      AssertThrow(!error,
+                  dealii::ExcMessage("Cannot create the output directory '" +
+                                     output_directory +
+                                     "': " + error.message()));
+      std::filesystem::copy_file(
+        parameter_file,
+        output_directory + "/" +
+          std::filesystem::path(parameter_file).filename().string(),
+        std::filesystem::copy_options::overwrite_existing);
+    }
     MPI_Barrier(comm);
     log.open(output_directory + "/log.txt", root, !quiet);
     statistics.open(output_directory + "/statistics.csv", root);
@@ -173,7 +177,7 @@ namespace ImmersedGrains
   Simulation<dim>::setup()
   {
     {
-      dealii::TimerOutput::Scope scope(timer, "mesh");
+      dealii::TimerOutput::Scope scope(*timer, "mesh");
       geometry.create_mesh(triangulation);
     }
     pcout << "immersed-grains: " << dim << "D scene " << parameter_file
@@ -186,21 +190,21 @@ namespace ImmersedGrains
     pcout << '\n';
 
     if (fluid_parameters.enabled)
-      {
-        fluid = std::make_unique<FluidSolver<dim>>(
-          fluid_parameters, geometry, triangulation, timer, pcout);
-        fluid->setup_dofs();
-        fluid->set_initial_condition();
-        pcout << "  fluid: "
-              << (fluid_parameters.advection ? "Navier-Stokes" : "Stokes")
-              << (fluid_parameters.time_derivative ?
-                    (fluid_parameters.bdf_order == 2 ? ", BDF2" : ", BDF1") :
-                    ", steady")
-              << ", Q2-Q1, " << fluid->n_dofs() << " DoFs, "
-              << (fluid_parameters.direct_solver ? "direct solver" :
-                                                   "FGMRES + block AMG")
-              << '\n';
-      }
+    {
+      fluid = std::make_unique<FluidSolver<dim>>(
+        fluid_parameters, geometry, triangulation, *timer, pcout);
+      fluid->setup_dofs();
+      fluid->set_initial_condition();
+      pcout << "  fluid: "
+            << (fluid_parameters.advection ? "Navier-Stokes" : "Stokes")
+            << (fluid_parameters.time_derivative ?
+                  (fluid_parameters.bdf_order == 2 ? ", BDF2" : ", BDF1") :
+                  ", steady")
+            << ", Q2-Q1, " << fluid->n_dofs() << " DoFs, "
+            << (fluid_parameters.direct_solver ? "direct solver" :
+                                                 "FGMRES + block AMG")
+            << '\n';
+    }
   }
 
 
@@ -208,6 +212,10 @@ namespace ImmersedGrains
   void
   Simulation<dim>::run()
   {
+    // Created only now: a TimerOutput alive while a parse error unwinds
+    // would print its own complaint beside the one-line message.
+    timer = std::make_unique<dealii::TimerOutput>(
+      comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times);
     prepare_output_directory();
     setup();
     postprocess(0, 0);
@@ -215,16 +223,16 @@ namespace ImmersedGrains
 
     // Steps end exactly on End time; a last short step is allowed.
     while (time < end_time * (1 - 1e-12))
-      {
-        const double dt = std::min(time_step, end_time - time);
-        ++step;
-        solve_time_step(dt);
-        maybe_write_fields(time >= end_time * (1 - 1e-12));
-      }
+    {
+      const double dt = std::min(time_step, end_time - time);
+      ++step;
+      solve_time_step(dt);
+      maybe_write_fields(time >= end_time * (1 - 1e-12));
+    }
 
     pcout << "  done: " << step << " steps, wall time " << now() - wall_start
           << " s\n";
-    timer.print_wall_time_statistics(comm);
+    timer->print_wall_time_statistics(comm);
   }
 
 
@@ -235,12 +243,12 @@ namespace ImmersedGrains
     unsigned int fluid_iterations = 0;
     double       new_time         = time + dt;
     if (fluid)
-      {
-        const auto stats = fluid->solve_time_step(new_time, dt);
-        fluid_iterations = stats.linear_iterations;
-        statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
-        statistics.set("fluid_residual", stats.final_residual);
-      }
+    {
+      const auto stats = fluid->solve_time_step(new_time, dt);
+      fluid_iterations = stats.linear_iterations;
+      statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
+      statistics.set("fluid_residual", stats.final_residual);
+    }
     time = new_time;
     postprocess(dt, fluid_iterations);
   }
@@ -248,24 +256,25 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  Simulation<dim>::postprocess(const double dt, const unsigned int fluid_iterations)
+  Simulation<dim>::postprocess(const double       dt,
+                               const unsigned int fluid_iterations)
   {
-    dealii::TimerOutput::Scope scope(timer, "statistics");
+    dealii::TimerOutput::Scope scope(*timer, "statistics");
     statistics.set("step", step);
     statistics.set("time", time);
     statistics.set("dt", dt);
     statistics.set("cells", triangulation.n_global_active_cells());
     statistics.set("fluid_iterations", fluid_iterations);
     if (fluid)
-      {
-        double volume = 1;
-        for (unsigned int d = 0; d < dim; ++d)
-          volume *= geometry.upper_corner[d] - geometry.lower_corner[d];
-        const double fluid_volume = fluid->integrate_fluid_fraction();
-        statistics.set("dofs", fluid->n_dofs());
-        statistics.set("fluid_volume", fluid_volume);
-        statistics.set("solid_volume", volume - fluid_volume);
-      }
+    {
+      double volume = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        volume *= geometry.upper_corner[d] - geometry.lower_corner[d];
+      const double fluid_volume = fluid->integrate_fluid_fraction();
+      statistics.set("dofs", fluid->n_dofs());
+      statistics.set("fluid_volume", fluid_volume);
+      statistics.set("solid_volume", volume - fluid_volume);
+    }
     statistics.set("wall_time", now() - wall_start);
     statistics.write_row();
 
@@ -285,10 +294,12 @@ namespace ImmersedGrains
       return;
     if (!force && (write_fields_every == 0 || step % write_fields_every != 0))
       return;
-    dealii::TimerOutput::Scope scope(timer, "output");
-    field_output->write(triangulation, time, step, [this](dealii::DataOut<dim> &d) {
-      fluid->add_data_vectors(d);
-    });
+    dealii::TimerOutput::Scope scope(*timer, "output");
+    field_output->write(triangulation,
+                        time,
+                        step,
+                        [this](dealii::DataOut<dim> &d)
+                        { fluid->add_data_vectors(d); });
   }
 
 

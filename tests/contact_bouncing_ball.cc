@@ -30,7 +30,7 @@ using dealii::Tensor;
 namespace
 {
   const double gravity = 9.81;
-  const double h0      = 1.0;  // initial height of the ball's bottom
+  const double h0      = 1.0; // initial height of the ball's bottom
   const double radius  = 0.05;
 
   struct Run
@@ -65,22 +65,22 @@ namespace
     Run    run{{}, -1, true};
     double last_moving = 0;
     for (unsigned int step = 0; step * dt < end_time; ++step)
-      {
-        const double t = (step + 1) * dt;
-        ball.start_velocity = ball.velocity;
-        ball.velocity[0][dim - 1] -= dt * gravity;
-        walls.find_contacts(x, ball.radius, radius, contacts);
-        run.solver_ok &=
-          solver.solve({}, contacts, walls.velocities(), ball, dt).converged;
-        x[0] += dt * ball.velocity[0];
+    {
+      const double t      = (step + 1) * dt;
+      ball.start_velocity = ball.velocity;
+      ball.velocity[0][dim - 1] -= dt * gravity;
+      walls.find_contacts(x, ball.radius, radius, contacts);
+      run.solver_ok &=
+        solver.solve({}, contacts, walls.velocities(), ball, dt).converged;
+      x[0] += dt * ball.velocity[0];
 
-        const double vz_before = ball.start_velocity[0][dim - 1];
-        const double vz        = ball.velocity[0][dim - 1];
-        if (vz_before > 0 && vz <= 0)
-          run.apex.push_back(x[0][dim - 1] - radius);
-        if (ball.velocity[0].norm() > 0)
-          last_moving = t;
-      }
+      const double vz_before = ball.start_velocity[0][dim - 1];
+      const double vz        = ball.velocity[0][dim - 1];
+      if (vz_before > 0 && vz <= 0)
+        run.apex.push_back(x[0][dim - 1] - radius);
+      if (ball.velocity[0].norm() > 0)
+        last_moving = t;
+    }
     if (last_moving < end_time - dt)
       run.rest_time = last_moving;
     return run;
@@ -96,8 +96,7 @@ namespace
     const double t0 = std::sqrt(2 * h0 / gravity);
     const double V0 = gravity * t0;
     const double T  = (e < 1 ? t0 + 2 * e * V0 / (gravity * (1 - e)) : 0.);
-    const double end_time =
-      (e < 1 ? 1.5 * T : t0 * (2 * n_bounces + 1.5));
+    const double end_time = (e < 1 ? 1.5 * T : t0 * (2 * n_bounces + 1.5));
 
     const Run fine   = drop<dim>(e, dt / 2, end_time);
     const Run coarse = drop<dim>(e, dt, end_time);
@@ -105,35 +104,35 @@ namespace
     bool ok = coarse.solver_ok && fine.solver_ok &&
               coarse.apex.size() >= n_bounces && fine.apex.size() >= n_bounces;
     for (unsigned int k = 1; ok && k <= n_bounces; ++k)
-      {
-        const double expected = std::pow(e, 2 * k) * h0;
-        const double V_k      = std::pow(e, k) * V0;
-        const double limit    = 4 * k * gravity * dt / V_k;
-        const double error    = std::abs(coarse.apex[k - 1] / expected - 1);
-        const double error_fine = std::abs(fine.apex[k - 1] / expected - 1);
-        const bool   within     = (error <= limit);
-        const bool   half_dt_ok = (error_fine <= limit / 2);
-        ok = ok && within && half_dt_ok;
-        std::printf("  apex %u: h = %.4f, e^%u h0 = %.4f, "
-                    "within 4 k g dt / V_k: %s, at dt/2 within half: %s\n",
-                    k,
-                    coarse.apex[k - 1],
-                    2 * k,
-                    expected,
-                    within ? "yes" : "no",
-                    half_dt_ok ? "yes" : "no");
-      }
+    {
+      const double expected   = std::pow(e, 2 * k) * h0;
+      const double V_k        = std::pow(e, k) * V0;
+      const double limit      = 4 * k * gravity * dt / V_k;
+      const double error      = std::abs(coarse.apex[k - 1] / expected - 1);
+      const double error_fine = std::abs(fine.apex[k - 1] / expected - 1);
+      const bool   within     = (error <= limit);
+      const bool   half_dt_ok = (error_fine <= limit / 2);
+      ok                      = ok && within && half_dt_ok;
+      std::printf("  apex %u: h = %.4f, e^%u h0 = %.4f, "
+                  "within 4 k g dt / V_k: %s, at dt/2 within half: %s\n",
+                  k,
+                  coarse.apex[k - 1],
+                  2 * k,
+                  expected,
+                  within ? "yes" : "no",
+                  half_dt_ok ? "yes" : "no");
+    }
     if (e < 1)
-      {
-        const bool at_rest =
-          coarse.rest_time > 0 && std::abs(coarse.rest_time - T) < 0.02 * T;
-        ok = ok && at_rest;
-        std::printf("  at rest after t = %.2f s (finite-time limit T = %.2f "
-                    "s, within 2 %%: %s)\n",
-                    coarse.rest_time,
-                    T,
-                    at_rest ? "yes" : "no");
-      }
+    {
+      const bool at_rest =
+        coarse.rest_time > 0 && std::abs(coarse.rest_time - T) < 0.02 * T;
+      ok = ok && at_rest;
+      std::printf("  at rest after t = %.2f s (finite-time limit T = %.2f "
+                  "s, within 2 %%: %s)\n",
+                  coarse.rest_time,
+                  T,
+                  at_rest ? "yes" : "no");
+    }
     std::printf("  %s\n", ok ? "OK" : "FAILED");
     all_ok = all_ok && ok;
   }

@@ -44,16 +44,16 @@ namespace
     // Not along an axis, so that every component is exercised.
     Tensor<1, dim> n;
     if (dim == 2)
-      {
-        n[0] = 0.6;
-        n[1] = 0.8;
-      }
+    {
+      n[0] = 0.6;
+      n[1] = 0.8;
+    }
     else
-      {
-        n[0] = 2. / 7;
-        n[1] = 3. / 7;
-        n[dim - 1] = 6. / 7;
-      }
+    {
+      n[0]       = 2. / 7;
+      n[1]       = 3. / 7;
+      n[dim - 1] = 6. / 7;
+    }
     return n;
   }
 
@@ -63,16 +63,16 @@ namespace
   {
     Tensor<1, dim> t;
     if (dim == 2)
-      {
-        t[0] = -0.8;
-        t[1] = 0.6;
-      }
+    {
+      t[0] = -0.8;
+      t[1] = 0.6;
+    }
     else
-      {
-        t[0] = 3. / 7;
-        t[1] = -6. / 7;
-        t[dim - 1] = 2. / 7;
-      }
+    {
+      t[0]       = 3. / 7;
+      t[1]       = -6. / 7;
+      t[dim - 1] = 2. / 7;
+    }
     return t;
   }
 
@@ -95,12 +95,12 @@ namespace
 
   template <int dim>
   SolverResult
-  collide(GrainArrays<dim>         &g,
-          const double              gap,
-          const double              e,
-          const double              mu,
-          std::vector<double>      *impulse = nullptr,
-          ContactImpulses<dim>     *all     = nullptr)
+  collide(GrainArrays<dim>     &g,
+          const double          gap,
+          const double          e,
+          const double          mu,
+          std::vector<double>  *impulse = nullptr,
+          ContactImpulses<dim> *all     = nullptr)
   {
     const Tensor<1, dim>    n = unit_normal<dim>();
     std::vector<Point<dim>> x(2);
@@ -108,10 +108,10 @@ namespace
 
     Point<dim> lower, upper;
     for (unsigned int d = 0; d < dim; ++d)
-      {
-        lower[d] = -5;
-        upper[d] = 5;
-      }
+    {
+      lower[d] = -5;
+      upper[d] = 5;
+    }
     BucketGrid<dim>             grid(lower, upper);
     std::vector<GrainPair<dim>> pairs;
     grid.find_pairs(x, g.radius, 0.1, pairs);
@@ -138,37 +138,34 @@ namespace
     for (const double e : {0., 0.5, 1.})
       for (const double m2 : {2., 7.})
         for (const bool oblique : {false, true})
+        {
+          const double   m1 = 2;
+          Tensor<1, dim> v1 = 1.3 * n, v2 = -0.4 * n;
+          if (oblique)
           {
-            const double   m1 = 2;
-            Tensor<1, dim> v1 = 1.3 * n, v2 = -0.4 * n;
-            if (oblique)
-              {
-                v1 += 0.9 * t;
-                v2 -= 1.1 * t;
-              }
-            GrainArrays<dim> g = two_grains<dim>(m1, m2, v1, v2);
-            collide(g, 0., e, 0.);
-
-            const double         v12n = (v1 - v2) * n;
-            const Tensor<1, dim> e1 =
-              v1 - (1 + e) * m2 / (m1 + m2) * v12n * n;
-            const Tensor<1, dim> e2 =
-              v2 + (1 + e) * m1 / (m1 + m2) * v12n * n;
-            const double error =
-              std::max((g.velocity[0] - e1).norm(),
-                       (g.velocity[1] - e2).norm()) /
-              std::max(v1.norm(), v2.norm());
-
-            char name[80];
-            std::snprintf(name,
-                          sizeof(name),
-                          "%dD e=%.1f %s masses %s",
-                          dim,
-                          e,
-                          m2 == m1 ? "equal  " : "unequal",
-                          oblique ? "oblique" : "head-on");
-            report(name, error, 1e-10);
+            v1 += 0.9 * t;
+            v2 -= 1.1 * t;
           }
+          GrainArrays<dim> g = two_grains<dim>(m1, m2, v1, v2);
+          collide(g, 0., e, 0.);
+
+          const double         v12n = (v1 - v2) * n;
+          const Tensor<1, dim> e1   = v1 - (1 + e) * m2 / (m1 + m2) * v12n * n;
+          const Tensor<1, dim> e2   = v2 + (1 + e) * m1 / (m1 + m2) * v12n * n;
+          const double         error =
+            std::max((g.velocity[0] - e1).norm(), (g.velocity[1] - e2).norm()) /
+            std::max(v1.norm(), v2.norm());
+
+          char name[80];
+          std::snprintf(name,
+                        sizeof(name),
+                        "%dD e=%.1f %s masses %s",
+                        dim,
+                        e,
+                        m2 == m1 ? "equal  " : "unequal",
+                        oblique ? "oblique" : "head-on");
+          report(name, error, 1e-10);
+        }
   }
 
   // A grain against an infinitely heavy partner: a fixed grain, then a
@@ -180,54 +177,53 @@ namespace
     const Tensor<1, dim> n = unit_normal<dim>();
     const Tensor<1, dim> t = unit_tangent<dim>();
     for (const double e : {0., 0.5, 1.})
-      {
-        const Tensor<1, dim> v = 1.3 * n + 0.7 * t;
-        GrainArrays<dim>     g = two_grains<dim>(2., 0., v, Tensor<1, dim>());
-        collide(g, 0., e, 0.);
-        const Tensor<1, dim> expected = v - (1 + e) * (v * n) * n;
-        char                 name[80];
-        std::snprintf(name, sizeof(name), "%dD e=%.1f fixed grain", dim, e);
-        report(name,
-               std::max((g.velocity[0] - expected).norm(),
-                        g.velocity[1].norm()) /
-                 v.norm(),
-               1e-10);
-      }
+    {
+      const Tensor<1, dim> v = 1.3 * n + 0.7 * t;
+      GrainArrays<dim>     g = two_grains<dim>(2., 0., v, Tensor<1, dim>());
+      collide(g, 0., e, 0.);
+      const Tensor<1, dim> expected = v - (1 + e) * (v * n) * n;
+      char                 name[80];
+      std::snprintf(name, sizeof(name), "%dD e=%.1f fixed grain", dim, e);
+      report(name,
+             std::max((g.velocity[0] - expected).norm(), g.velocity[1].norm()) /
+               v.norm(),
+             1e-10);
+    }
 
     for (const double e : {0., 0.5, 1.})
-      {
-        // Floor through the origin with inward normal (0,..,1), moving.
-        Walls<dim>     walls;
-        Tensor<1, dim> up, wall_velocity;
-        up[dim - 1]      = 1;
-        wall_velocity[0] = 0.3;
-        wall_velocity[dim - 1] = 0.2;
-        walls.add_plane(Point<dim>(), up, wall_velocity);
+    {
+      // Floor through the origin with inward normal (0,..,1), moving.
+      Walls<dim>     walls;
+      Tensor<1, dim> up, wall_velocity;
+      up[dim - 1]            = 1;
+      wall_velocity[0]       = 0.3;
+      wall_velocity[dim - 1] = 0.2;
+      walls.add_plane(Point<dim>(), up, wall_velocity);
 
-        GrainArrays<dim> g;
-        Tensor<1, dim>   v;
-        v[0]             = 0.8;
-        v[dim - 1]       = -1.5;
-        g.velocity       = {v};
-        g.start_velocity = {v};
-        g.inverse_mass   = {0.5};
-        g.radius         = {0.5};
-        std::vector<Point<dim>> x(1);
-        x[0][dim - 1] = 0.5;
-        std::vector<WallContact<dim>> contacts;
-        walls.find_contacts(x, g.radius, 0.1, contacts);
+      GrainArrays<dim> g;
+      Tensor<1, dim>   v;
+      v[0]             = 0.8;
+      v[dim - 1]       = -1.5;
+      g.velocity       = {v};
+      g.start_velocity = {v};
+      g.inverse_mass   = {0.5};
+      g.radius         = {0.5};
+      std::vector<Point<dim>> x(1);
+      x[0][dim - 1] = 0.5;
+      std::vector<WallContact<dim>> contacts;
+      walls.find_contacts(x, g.radius, 0.1, contacts);
 
-        ContactParameters parameters;
-        parameters.restitution = e;
-        parameters.tolerance   = 1e-14;
-        ContactSolver<dim> solver(parameters);
-        solver.solve({}, contacts, walls.velocities(), g, dt);
-        const Tensor<1, dim> expected =
-          v - (1 + e) * ((v - wall_velocity) * up) * up;
-        char name[80];
-        std::snprintf(name, sizeof(name), "%dD e=%.1f moving wall", dim, e);
-        report(name, (g.velocity[0] - expected).norm() / v.norm(), 1e-10);
-      }
+      ContactParameters parameters;
+      parameters.restitution = e;
+      parameters.tolerance   = 1e-14;
+      ContactSolver<dim> solver(parameters);
+      solver.solve({}, contacts, walls.velocities(), g, dt);
+      const Tensor<1, dim> expected =
+        v - (1 + e) * ((v - wall_velocity) * up) * up;
+      char name[80];
+      std::snprintf(name, sizeof(name), "%dD e=%.1f moving wall", dim, e);
+      report(name, (g.velocity[0] - expected).norm() / v.norm(), 1e-10);
+    }
   }
 
   // What the step does with contacts that are not simply touching.
@@ -252,8 +248,8 @@ namespace
     }
     // Meeting within the step with e = 0: the gap closes exactly, no more.
     {
-      const double        gap = 0.4 * 2 * dt;
-      GrainArrays<dim>    g   = two_grains<dim>(2., 3., n, -n);
+      const double     gap = 0.4 * 2 * dt;
+      GrainArrays<dim> g   = two_grains<dim>(2., 3., n, -n);
       collide(g, gap, 0., 0.);
       const double end_gap = gap + dt * (g.velocity[1] - g.velocity[0]) * n;
       std::snprintf(name, sizeof(name), "%dD e=0 closes the gap exactly", dim);
@@ -271,7 +267,8 @@ namespace
     // An overlap at rest is removed within one step, without restitution.
     {
       const double     overlap = 1e-3;
-      GrainArrays<dim> g = two_grains<dim>(2., 3., Tensor<1, dim>(), Tensor<1, dim>());
+      GrainArrays<dim> g =
+        two_grains<dim>(2., 3., Tensor<1, dim>(), Tensor<1, dim>());
       collide(g, -overlap, 1., 0.);
       const double end_gap =
         -overlap + dt * (g.velocity[1] - g.velocity[0]) * n;
@@ -298,32 +295,33 @@ namespace
   void
   friction_pair(const double mu)
   {
-    const Tensor<1, dim> n = unit_normal<dim>();
-    const Tensor<1, dim> t = unit_tangent<dim>();
+    const Tensor<1, dim> n  = unit_normal<dim>();
+    const Tensor<1, dim> t  = unit_tangent<dim>();
     const double         m1 = 2, m2 = 5;
     GrainArrays<dim>     g =
       two_grains<dim>(m1, m2, 1.3 * n + 0.9 * t, -0.4 * n - 1.1 * t);
     const double I1 = 0.4 * m1 * 0.25, I2 = 0.4 * m2 * 0.49;
     g.inverse_inertia = {1 / I1, 1 / I2};
     for (unsigned int c = 0; c < AngularVelocity<dim>::dimension; ++c)
-      {
-        g.angular_velocity[0][c] = 0.7 - 0.3 * c;
-        g.angular_velocity[1][c] = -1.1 + 0.5 * c;
-      }
+    {
+      g.angular_velocity[0][c] = 0.7 - 0.3 * c;
+      g.angular_velocity[1][c] = -1.1 + 0.5 * c;
+    }
     const GrainArrays<dim> before = g;
     ContactImpulses<dim>   impulses;
     collide(g, 0., 0.5, mu, nullptr, &impulses);
 
     const Point<dim> x1, x2(n * 1.2);
-    const auto       momenta = [&](const GrainArrays<dim> &s) {
+    const auto       momenta = [&](const GrainArrays<dim> &s)
+    {
       std::vector<double> m(dim + AngularVelocity<dim>::dimension);
       for (unsigned int d = 0; d < dim; ++d)
         m[d] = m1 * s.velocity[0][d] + m2 * s.velocity[1][d];
       for (unsigned int c = 0; c < AngularVelocity<dim>::dimension; ++c)
-        m[dim + c] =
-          m1 * cross_z_or_vector_part<dim>(x1, s.velocity[0], c) +
-          m2 * cross_z_or_vector_part<dim>(x2, s.velocity[1], c) +
-          I1 * s.angular_velocity[0][c] + I2 * s.angular_velocity[1][c];
+        m[dim + c] = m1 * cross_z_or_vector_part<dim>(x1, s.velocity[0], c) +
+                     m2 * cross_z_or_vector_part<dim>(x2, s.velocity[1], c) +
+                     I1 * s.angular_velocity[0][c] +
+                     I2 * s.angular_velocity[1][c];
       return m;
     };
     const std::vector<double> m0 = momenta(before), m_end = momenta(g);
@@ -331,24 +329,22 @@ namespace
     for (unsigned int k = 0; k < m0.size(); ++k)
       error = std::max(error, std::abs(m_end[k] - m0[k]));
     char name[80];
-    std::snprintf(name,
-                  sizeof(name),
-                  "%dD mu=%.2f momentum and angular momentum",
-                  dim,
-                  mu);
+    std::snprintf(
+      name, sizeof(name), "%dD mu=%.2f momentum and angular momentum", dim, mu);
     report(name, error / (m2 * 1.5), 1e-10);
 
     // Coulomb: inside the cone with zero slip, or on its edge opposite to
     // the slip.
-    const auto spin_velocity = [&](const unsigned int i, const double r) {
+    const auto spin_velocity = [&](const unsigned int i, const double r)
+    {
       // w x (r n) for the lever r n.
       Tensor<1, dim> v;
       const auto    &w = g.angular_velocity[i];
       if (dim == 2)
-        {
-          v[0] = -w[0] * r * n[1];
-          v[1] = w[0] * r * n[0];
-        }
+      {
+        v[0] = -w[0] * r * n[1];
+        v[1] = w[0] * r * n[0];
+      }
       else
         for (unsigned int c = 0; c < 3; ++c)
           v[c] = r * (w[(c + 1) % 3] * n[(c + 2) % 3] -
@@ -413,14 +409,13 @@ namespace
     solver.solve({}, contacts, walls.velocities(), g, dt);
 
     const bool   stick = (mu >= 1);
-    const double v_t =
-      stick ? v[0] * (1 - 1 / (m * (1 / m + r * r / I))) :
-              v[0] - mu * (1 + e) * std::abs(v[dim - 1]);
+    const double v_t   = stick ? v[0] * (1 - 1 / (m * (1 / m + r * r / I))) :
+                                 v[0] - mu * (1 + e) * std::abs(v[dim - 1]);
     // Spin axis: -z in 2D, +y in 3D, for motion along +x on a floor below.
     const double spin =
       stick ? v_t / r : r * mu * (1 + e) * std::abs(v[dim - 1]) * m / I;
-    const double w = (dim == 2 ? -g.angular_velocity[0][0] :
-                                 g.angular_velocity[0][dim - 2]);
+    const double w =
+      (dim == 2 ? -g.angular_velocity[0][0] : g.angular_velocity[0][dim - 2]);
     const double error =
       std::max({std::abs(g.velocity[0][0] - v_t),
                 std::abs(g.velocity[0][dim - 1] - e * std::abs(v[dim - 1])),
@@ -447,12 +442,12 @@ main()
   step_laws<2>();
   step_laws<3>();
   for (const double mu : {0.05, 2.})
-    {
-      friction_pair<2>(mu);
-      friction_pair<3>(mu);
-      friction_on_floor<2>(mu);
-      friction_on_floor<3>(mu);
-    }
+  {
+    friction_pair<2>(mu);
+    friction_pair<3>(mu);
+    friction_on_floor<2>(mu);
+    friction_on_floor<3>(mu);
+  }
   std::printf("max relative error < 1e-10: %s\n", all_ok ? "yes" : "NO");
   return all_ok ? 0 : 1;
 }

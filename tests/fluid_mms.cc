@@ -23,14 +23,15 @@ using namespace ImmersedGrains;
 template <int dim>
 struct TrigProduct
 {
-  double            a;
+  double                a;
   std::array<bool, dim> is_sin;
 
   double
   factor(const Point<dim> &x, unsigned int d, unsigned int derivative) const
   {
     const double s = std::sin(M_PI * x[d]), c = std::cos(M_PI * x[d]);
-    // derivatives of sin: sin, pi cos, -pi^2 sin; of cos: cos, -pi sin, -pi^2 cos
+    // derivatives of sin: sin, pi cos, -pi^2 sin; of cos: cos, -pi sin, -pi^2
+    // cos
     if (derivative == 0)
       return is_sin[d] ? s : c;
     if (derivative == 1)
@@ -39,7 +40,8 @@ struct TrigProduct
   }
 
   double
-  derivative(const Point<dim> &x, const std::array<unsigned int, dim> &order) const
+  derivative(const Point<dim>                    &x,
+             const std::array<unsigned int, dim> &order) const
   {
     double v = a;
     for (unsigned int d = 0; d < dim; ++d)
@@ -58,11 +60,11 @@ struct TrigProduct
   {
     Tensor<1, dim> g;
     for (unsigned int k = 0; k < dim; ++k)
-      {
-        std::array<unsigned int, dim> o{};
-        o[k] = 1;
-        g[k] = derivative(x, o);
-      }
+    {
+      std::array<unsigned int, dim> o{};
+      o[k] = 1;
+      g[k] = derivative(x, o);
+    }
     return g;
   }
 
@@ -71,11 +73,11 @@ struct TrigProduct
   {
     double l = 0;
     for (unsigned int k = 0; k < dim; ++k)
-      {
-        std::array<unsigned int, dim> o{};
-        o[k] = 2;
-        l += derivative(x, o);
-      }
+    {
+      std::array<unsigned int, dim> o{};
+      o[k] = 2;
+      l += derivative(x, o);
+    }
     return l;
   }
 };
@@ -98,8 +100,8 @@ struct Manufactured
 {
   std::vector<TrigProduct<dim>> u, up;
   TrigProduct<dim>              p, phi_var, beta_var;
-  double phi0 = 0.675, beta0 = 50, rho = 1, mu = 1;
-  bool   advection = false;
+  double                        phi0 = 0.675, beta0 = 50, rho = 1, mu = 1;
+  bool                          advection = false;
 
   Manufactured()
   {
@@ -129,9 +131,10 @@ class ScalarFn : public Function<dim>
 public:
   ScalarFn(std::function<double(const Point<dim> &)>         v,
            std::function<Tensor<1, dim>(const Point<dim> &)> g)
-    : v(v)
-    , g(g)
-  {}
+      : v(v)
+      , g(g)
+  {
+  }
   double
   value(const Point<dim> &x, unsigned int) const override
   {
@@ -153,9 +156,10 @@ class VectorFn : public Function<dim>
 {
 public:
   VectorFn(const std::vector<TrigProduct<dim>> &c, unsigned int n)
-    : Function<dim>(n)
-    , c(c)
-  {}
+      : Function<dim>(n)
+      , c(c)
+  {
+  }
   double
   value(const Point<dim> &x, unsigned int i) const override
   {
@@ -176,9 +180,10 @@ class ExactSolution : public Function<dim>
 {
 public:
   explicit ExactSolution(const Manufactured<dim> &m)
-    : Function<dim>(dim + 1)
-    , m(m)
-  {}
+      : Function<dim>(dim + 1)
+      , m(m)
+  {
+  }
   double
   value(const Point<dim> &x, unsigned int i) const override
   {
@@ -200,19 +205,19 @@ class Forcing : public Function<dim>
 {
 public:
   explicit Forcing(const Manufactured<dim> &m)
-    : Function<dim>(dim)
-    , m(m)
-  {}
+      : Function<dim>(dim)
+      , m(m)
+  {
+  }
   double
   value(const Point<dim> &x, unsigned int i) const override
   {
     const double phi      = m.phi(x);
     const auto   grad_phi = m.phi_var.gradient(x);
     const double beta     = m.beta0 + m.beta_var.value(x);
-    double       f = -m.mu * (grad_phi * m.u[i].gradient(x) +
-                        phi * m.u[i].laplacian(x)) +
-               phi * m.p.gradient(x)[i] +
-               beta * (m.u[i].value(x) - m.up[i].value(x));
+    double       f =
+      -m.mu * (grad_phi * m.u[i].gradient(x) + phi * m.u[i].laplacian(x)) +
+      phi * m.p.gradient(x)[i] + beta * (m.u[i].value(x) - m.up[i].value(x));
     if (m.advection)
       for (unsigned int k = 0; k < dim; ++k)
         f += phi * m.rho * m.u[k].value(x) * m.u[i].gradient(x)[k];
@@ -225,24 +230,29 @@ private:
 
 template <int dim>
 void
-study(const bool advection, const unsigned int coarse, const unsigned int levels)
+study(const bool         advection,
+      const unsigned int coarse,
+      const unsigned int levels)
 {
   Manufactured<dim> m;
   m.advection = advection;
 
   ParameterHandler prm;
   Simulation<dim>::declare_parameters(prm);
-  prm.parse_input_from_string(std::string(R"(
+  prm.parse_input_from_string(
+    std::string(R"(
 subsection Mesh
-  set Boundary conditions = )") + (dim == 2 ? "velocity, velocity, velocity, velocity" :
-                                         "velocity, velocity, velocity, velocity, velocity, velocity") +
-                              R"(
+  set Boundary conditions = )") +
+    (dim == 2 ? "velocity, velocity, velocity, velocity" :
+                "velocity, velocity, velocity, velocity, velocity, velocity") +
+    R"(
 end
 subsection Fluid
   set Density = 1
   set Viscosity = 1
   set Time derivative = false
-  set Advection = )" + (advection ? "true" : "false") + R"(
+  set Advection = )" +
+    (advection ? "true" : "false") + R"(
   set Nonlinear tolerance = 1e-10
   subsection Linear solver
     set Tolerance = 1e-11
@@ -254,16 +264,20 @@ end
   FluidParameters<dim> parameters;
   parameters.parse_parameters(prm, "fluid_mms", geometry);
 
-  auto phi = std::make_shared<ScalarFn<dim>>(
-    [&m](const Point<dim> &x) { return m.phi(x); },
-    [&m](const Point<dim> &x) { return m.phi_var.gradient(x); });
-  auto beta = std::make_shared<ScalarFn<dim>>(
-    [&m](const Point<dim> &x) { return m.beta0 + m.beta_var.value(x); },
-    [&m](const Point<dim> &x) { return m.beta_var.gradient(x); });
+  auto phi = std::make_shared<ScalarFn<dim>>([&m](const Point<dim> &x)
+                                             { return m.phi(x); },
+                                             [&m](const Point<dim> &x)
+                                             { return m.phi_var.gradient(x); });
+  auto beta =
+    std::make_shared<ScalarFn<dim>>([&m](const Point<dim> &x)
+                                    { return m.beta0 + m.beta_var.value(x); },
+                                    [&m](const Point<dim> &x)
+                                    { return m.beta_var.gradient(x); });
   auto up = std::make_shared<VectorFn<dim>>(m.up, dim);
   // g = div(phi u) + div((1 - phi) u_p), with div u = 0.
   auto mass_source = std::make_shared<ScalarFn<dim>>(
-    [&m](const Point<dim> &x) {
+    [&m](const Point<dim> &x)
+    {
       double g = 0;
       for (unsigned int d = 0; d < dim; ++d)
         g += m.phi_var.gradient(x)[d] * (m.u[d].value(x) - m.up[d].value(x)) +
@@ -271,9 +285,10 @@ end
       return g;
     },
     [](const Point<dim> &) { return Tensor<1, dim>(); });
-  auto fields = std::make_shared<PrescribedMixtureFields<dim>>(phi, beta, up, mass_source);
-  auto velocity = std::make_shared<VectorFn<dim>>(m.u, dim);
-  auto forcing  = std::make_shared<Forcing<dim>>(m);
+  auto fields =
+    std::make_shared<PrescribedMixtureFields<dim>>(phi, beta, up, mass_source);
+  auto               velocity = std::make_shared<VectorFn<dim>>(m.u, dim);
+  auto               forcing  = std::make_shared<Forcing<dim>>(m);
   ExactSolution<dim> exact(m);
 
   ConditionalOStream pcout(std::cout, false);
@@ -286,35 +301,36 @@ end
   std::array<double, 3> previous{};
   std::array<double, 3> rates{};
   for (unsigned int level = coarse; level < coarse + levels; ++level)
+  {
+    parallel::distributed::Triangulation<dim> tria(MPI_COMM_WORLD);
+    geometry.initial_refinement = level;
+    geometry.create_mesh(tria);
+    FluidSolver<dim> fluid(parameters, geometry, tria, timer, pcout);
+    fluid.set_mixture_fields(fields);
+    fluid.set_forcing(forcing);
+    fluid.set_boundary_velocity(velocity);
+    fluid.setup_dofs();
+    fluid.set_initial_condition();
+    fluid.solve_time_step(1.0, 1.0);
+    const auto e = fluid.compute_errors(exact);
+    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
     {
-      parallel::distributed::Triangulation<dim> tria(MPI_COMM_WORLD);
-      geometry.initial_refinement = level;
-      geometry.create_mesh(tria);
-      FluidSolver<dim> fluid(parameters, geometry, tria, timer, pcout);
-      fluid.set_mixture_fields(fields);
-      fluid.set_forcing(forcing);
-      fluid.set_boundary_velocity(velocity);
-      fluid.setup_dofs();
-      fluid.set_initial_condition();
-      fluid.solve_time_step(1.0, 1.0);
-      const auto e = fluid.compute_errors(exact);
-      if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-        {
-          std::printf("   %u  %9.3e  %9.3e  %9.3e", level, e[0], e[1], e[2]);
-          if (level > coarse)
-            {
-              for (unsigned int k = 0; k < 3; ++k)
-                rates[k] = std::log2(previous[k] / e[k]);
-              std::printf("   %.2f %.2f %.2f", rates[0], rates[1], rates[2]);
-            }
-          std::printf("\n");
-        }
-      previous = e;
+      std::printf("   %u  %9.3e  %9.3e  %9.3e", level, e[0], e[1], e[2]);
+      if (level > coarse)
+      {
+        for (unsigned int k = 0; k < 3; ++k)
+          rates[k] = std::log2(previous[k] / e[k]);
+        std::printf("   %.2f %.2f %.2f", rates[0], rates[1], rates[2]);
+      }
+      std::printf("\n");
     }
+    previous = e;
+  }
   if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-    std::printf("   finest rates %s the floors (L2 u >= 2.8, H1 u >= 1.8, L2 p >= 1.8)\n",
-                (rates[0] >= 2.8 && rates[1] >= 1.8 && rates[2] >= 1.8) ? "meet" :
-                                                                          "MISS");
+    std::printf(
+      "   finest rates %s the floors (L2 u >= 2.8, H1 u >= 1.8, L2 p >= 1.8)\n",
+      (rates[0] >= 2.8 && rates[1] >= 1.8 && rates[2] >= 1.8) ? "meet" :
+                                                                "MISS");
 }
 
 int

@@ -68,10 +68,10 @@ namespace ImmersedGrains
     Geometry<dim>        geometry;
     FluidParameters<dim> fluid_parameters;
 
-    RunLog                     log;
-    dealii::ConditionalOStream pcout;
-    dealii::TimerOutput        timer;
-    Statistics                 statistics;
+    RunLog                               log;
+    dealii::ConditionalOStream           pcout;
+    std::unique_ptr<dealii::TimerOutput> timer;
+    Statistics                           statistics;
 
     dealii::parallel::distributed::Triangulation<dim> triangulation;
     std::unique_ptr<FluidSolver<dim>>                 fluid;

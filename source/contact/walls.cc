@@ -14,7 +14,8 @@ namespace ImmersedGrains
     {
       const double length = inward_normal.norm();
       AssertThrow(length > 0,
-                  dealii::ExcMessage("Walls: a plane needs a non-zero normal."));
+                  dealii::ExcMessage(
+                    "Walls: a plane needs a non-zero normal."));
       planes.push_back({point, inward_normal / length, velocity});
       wall_velocities.push_back(velocity);
       return planes.size() - 1;
@@ -31,14 +32,14 @@ namespace ImmersedGrains
       std::array<unsigned int, 2 * dim> numbers;
       numbers.fill(dealii::numbers::invalid_unsigned_int);
       for (unsigned int d = 0; d < dim; ++d)
-        {
-          Tensor<1, dim> e;
-          e[d] = 1;
-          if (is_wall[2 * d])
-            numbers[2 * d] = add_plane(lower, e);
-          if (is_wall[2 * d + 1])
-            numbers[2 * d + 1] = add_plane(upper, -e);
-        }
+      {
+        Tensor<1, dim> e;
+        e[d] = 1;
+        if (is_wall[2 * d])
+          numbers[2 * d] = add_plane(lower, e);
+        if (is_wall[2 * d + 1])
+          numbers[2 * d + 1] = add_plane(upper, -e);
+      }
       return numbers;
     }
 
@@ -97,13 +98,13 @@ namespace ImmersedGrains
       contacts.clear();
       for (unsigned int i = 0; i < positions.size(); ++i)
         for (unsigned int w = 0; w < planes.size(); ++w)
-          {
-            const double gap =
-              (positions[i] - planes[w].point) * planes[w].inward_normal -
-              radii[i];
-            if (gap < alert_distance)
-              contacts.push_back({i, w, -planes[w].inward_normal, gap});
-          }
+        {
+          const double gap =
+            (positions[i] - planes[w].point) * planes[w].inward_normal -
+            radii[i];
+          if (gap < alert_distance)
+            contacts.push_back({i, w, -planes[w].inward_normal, gap});
+        }
     }
 
 

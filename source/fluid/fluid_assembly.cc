@@ -30,10 +30,10 @@ namespace ImmersedGrains
     system_matrix = 0;
     system_rhs    = 0;
     if (assemble_preconditioner_matrices)
-      {
-        pressure_mass_matrix    = 0;
-        pressure_laplace_matrix = 0;
-      }
+    {
+      pressure_mass_matrix = 0;
+      reaction_diagonal    = 0;
+    }
 
     const dealii::QGauss<dim>     quadrature(fe.degree + 1);
     const dealii::QGauss<dim - 1> face_quadrature(fe.degree + 1);
@@ -44,13 +44,12 @@ namespace ImmersedGrains
                                       dealii::update_gradients |
                                       dealii::update_quadrature_points |
                                       dealii::update_JxW_values);
-    dealii::FEFaceValues<dim>     fe_face_values(mapping,
-                                             fe,
-                                             face_quadrature,
-                                             dealii::update_values |
-                                               dealii::update_normal_vectors |
-                                               dealii::update_quadrature_points |
-                                               dealii::update_JxW_values);
+    dealii::FEFaceValues<dim>     fe_face_values(
+      mapping,
+      fe,
+      face_quadrature,
+      dealii::update_values | dealii::update_normal_vectors |
+        dealii::update_quadrature_points | dealii::update_JxW_values);
 
     const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
     const unsigned int n_q           = quadrature.size();
@@ -59,8 +58,8 @@ namespace ImmersedGrains
 
     dealii::FullMatrix<double> cell_matrix(dofs_per_cell, dofs_per_cell);
     dealii::FullMatrix<double> cell_mass(dofs_per_cell, dofs_per_cell);
-    dealii::FullMatrix<double> cell_laplace(dofs_per_cell, dofs_per_cell);
     dealii::Vector<double>     cell_rhs(dofs_per_cell);
+    dealii::Vector<double>     cell_reaction(dofs_per_cell);
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
 
     std::vector<dealii::Tensor<1, dim>> u(n_q), u_old(n_q), u_older(n_q);
@@ -73,190 +72,177 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<2, dim>> grad_phi_u(dofs_per_cell);
     std::vector<double>                 div_phi_u(dofs_per_cell);
     std::vector<double>                 phi_p(dofs_per_cell);
-    std::vector<dealii::Tensor<1, dim>> grad_phi_p(dofs_per_cell);
 
     const double rho = parameters.density, mu = parameters.viscosity;
-    const double inv_dt = (parameters.time_derivative && dt > 0) ? 1.0 / dt : 0.0;
-    const bool   advection = parameters.advection;
-    const bool   newton    = parameters.newton && advection;
+    const double inv_dt =
+      (parameters.time_derivative && dt > 0) ? 1.0 / dt : 0.0;
+    const bool advection = parameters.advection;
+    const bool newton    = parameters.newton && advection;
     forcing->set_time(time);
     parameters.open_boundary_pressure->set_time(time);
 
-    // Without a face where the pressure is imposed the Laplacian of the
-    // Schur approximation is singular; a zero-order term a millionth of its
-    // scale at the domain size makes it invertible without changing it on
-    // any mode the solver sees.
-    const double diameter =
-      geometry.lower_corner.distance(geometry.upper_corner);
-    const double regularization =
-      pressure_has_null_space() ? 1e-6 / (diameter * diameter) : 0.0;
-    double max_laplace_weight = 0;
+    double max_beta = 0;
 
     for (const auto &cell : dof_handler.active_cell_iterators())
+    {
+      if (!cell->is_locally_owned())
+        continue;
+      fe_values.reinit(cell);
+      cell_matrix = 0;
+      cell_rhs    = 0;
+      if (assemble_preconditioner_matrices)
       {
-        if (!cell->is_locally_owned())
-          continue;
-        fe_values.reinit(cell);
-        cell_matrix = 0;
-        cell_rhs    = 0;
-        if (assemble_preconditioner_matrices)
-          {
-            cell_mass    = 0;
-            cell_laplace = 0;
-          }
-
-        mixture_fields->evaluate(cell,
-                                 fe_values.get_quadrature_points(),
-                                 time,
-                                 mixture);
-        fe_values[velocities].get_function_values(solution, u);
-        fe_values[velocities].get_function_gradients(solution, grad_u);
-        fe_values[pressure].get_function_values(solution, p);
-        if (inv_dt > 0)
-          {
-            fe_values[velocities].get_function_values(old_solution, u_old);
-            fe_values[velocities].get_function_values(old_old_solution, u_older);
-          }
-        forcing->vector_value_list(fe_values.get_quadrature_points(), f);
-
-        for (unsigned int q = 0; q < n_q; ++q)
-          {
-            const double  phi      = mixture.fluid_fraction[q];
-            const auto   &grad_phi = mixture.fluid_fraction_gradient[q];
-            const double  beta     = mixture.drag_coefficient[q];
-            const double  mass     = phi * rho * bdf[0] * inv_dt;
-            const double  JxW      = fe_values.JxW(q);
-
-            for (unsigned int k = 0; k < dofs_per_cell; ++k)
-              {
-                phi_u[k]      = fe_values[velocities].value(k, q);
-                grad_phi_u[k] = fe_values[velocities].gradient(k, q);
-                div_phi_u[k]  = fe_values[velocities].divergence(k, q);
-                phi_p[k]      = fe_values[pressure].value(k, q);
-                if (assemble_preconditioner_matrices)
-                  grad_phi_p[k] = fe_values[pressure].gradient(k, q);
-              }
-
-            // Strong-form pieces of the residual at this point.
-            dealii::Tensor<1, dim> momentum =
-              phi * rho * inv_dt *
-                (bdf[0] * u[q] + bdf[1] * u_old[q] + bdf[2] * u_older[q]) +
-              beta * (u[q] - mixture.grain_velocity[q]);
-            if (advection)
-              momentum += phi * rho * (grad_u[q] * u[q]);
-            for (unsigned int d = 0; d < dim; ++d)
-              momentum[d] -= f[q](d);
-            const dealii::Tensor<2, dim> viscous = phi * mu * grad_u[q];
-            const double continuity = phi * dealii::trace(grad_u[q]) +
-                                      grad_phi * u[q] +
-                                      mixture.solid_flux_divergence[q] -
-                                      mixture.mass_source[q];
-
-            for (unsigned int i = 0; i < dofs_per_cell; ++i)
-              {
-                const double div_phi_v = phi * div_phi_u[i] + grad_phi * phi_u[i];
-                cell_rhs(i) -=
-                  (momentum * phi_u[i] +
-                   dealii::scalar_product(viscous, grad_phi_u[i]) -
-                   p[q] * div_phi_v - phi_p[i] * continuity) *
-                  JxW;
-
-                for (unsigned int j = 0; j < dofs_per_cell; ++j)
-                  {
-                    dealii::Tensor<1, dim> a = (mass + beta) * phi_u[j];
-                    if (advection)
-                      {
-                        a += phi * rho * (grad_phi_u[j] * u[q]);
-                        if (newton)
-                          a += phi * rho * (grad_u[q] * phi_u[j]);
-                      }
-                    const double div_phi_uj =
-                      phi * div_phi_u[j] + grad_phi * phi_u[j];
-                    cell_matrix(i, j) +=
-                      (a * phi_u[i] +
-                       phi * mu * dealii::scalar_product(grad_phi_u[j],
-                                                         grad_phi_u[i]) -
-                       phi_p[j] * div_phi_v - phi_p[i] * div_phi_uj) *
-                      JxW;
-                  }
-              }
-
-            if (assemble_preconditioner_matrices)
-              {
-                // Viscous limit of S: (phi/mu) M_p; mass/drag limit:
-                // div(phi^2/(phi rho a0/dt + beta) grad p).
-                const double mass_weight    = phi / mu;
-                const double inertia        = mass + beta;
-                const double laplace_weight =
-                  inertia > 0 ? phi * phi / inertia : 0.0;
-                max_laplace_weight = std::max(max_laplace_weight, laplace_weight);
-                for (unsigned int i = 0; i < dofs_per_cell; ++i)
-                  if (fe.system_to_component_index(i).first == dim)
-                    for (unsigned int j = 0; j < dofs_per_cell; ++j)
-                      if (fe.system_to_component_index(j).first == dim)
-                        {
-                          cell_mass(i, j) +=
-                            mass_weight * phi_p[i] * phi_p[j] * JxW;
-                          cell_laplace(i, j) +=
-                            laplace_weight *
-                            (grad_phi_p[i] * grad_phi_p[j] +
-                             regularization * phi_p[i] * phi_p[j]) *
-                            JxW;
-                        }
-              }
-          }
-
-        // Weakly imposed pressure on open faces.
-        for (const unsigned int face_no : cell->face_indices())
-          {
-            const auto face = cell->face(face_no);
-            if (!face->at_boundary() ||
-                geometry.boundary_types[face->boundary_id()] !=
-                  BoundaryType::open)
-              continue;
-            fe_face_values.reinit(cell, face_no);
-            MixtureValues<dim> face_mixture;
-            mixture_fields->evaluate(cell,
-                                     fe_face_values.get_quadrature_points(),
-                                     time,
-                                     face_mixture);
-            for (unsigned int q = 0; q < face_quadrature.size(); ++q)
-              {
-                const double p_open = parameters.open_boundary_pressure->value(
-                  fe_face_values.quadrature_point(q));
-                const double weight = face_mixture.fluid_fraction[q] * p_open *
-                                      fe_face_values.JxW(q);
-                for (unsigned int i = 0; i < dofs_per_cell; ++i)
-                  cell_rhs(i) -= weight *
-                                 (fe_face_values[velocities].value(i, q) *
-                                  fe_face_values.normal_vector(q));
-              }
-          }
-
-        cell->get_dof_indices(dof_indices);
-        update_constraints.distribute_local_to_global(
-          cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
-        if (assemble_preconditioner_matrices)
-          {
-            pressure_mass_constraints.distribute_local_to_global(
-              cell_mass, dof_indices, pressure_mass_matrix);
-            pressure_laplace_constraints.distribute_local_to_global(
-              cell_laplace, dof_indices, pressure_laplace_matrix);
-          }
+        cell_mass     = 0;
+        cell_reaction = 0;
       }
+
+      mixture_fields->evaluate(cell,
+                               fe_values.get_quadrature_points(),
+                               time,
+                               mixture);
+      fe_values[velocities].get_function_values(solution, u);
+      fe_values[velocities].get_function_gradients(solution, grad_u);
+      fe_values[pressure].get_function_values(solution, p);
+      if (inv_dt > 0)
+      {
+        fe_values[velocities].get_function_values(old_solution, u_old);
+        fe_values[velocities].get_function_values(old_old_solution, u_older);
+      }
+      forcing->vector_value_list(fe_values.get_quadrature_points(), f);
+
+      for (unsigned int q = 0; q < n_q; ++q)
+      {
+        const double phi      = mixture.fluid_fraction[q];
+        const auto  &grad_phi = mixture.fluid_fraction_gradient[q];
+        const double beta     = mixture.drag_coefficient[q];
+        const double mass     = phi * rho * bdf[0] * inv_dt;
+        const double JxW      = fe_values.JxW(q);
+
+        for (unsigned int k = 0; k < dofs_per_cell; ++k)
+        {
+          phi_u[k]      = fe_values[velocities].value(k, q);
+          grad_phi_u[k] = fe_values[velocities].gradient(k, q);
+          div_phi_u[k]  = fe_values[velocities].divergence(k, q);
+          phi_p[k]      = fe_values[pressure].value(k, q);
+        }
+
+        // Strong-form pieces of the residual at this point.
+        dealii::Tensor<1, dim> momentum =
+          phi * rho * inv_dt *
+            (bdf[0] * u[q] + bdf[1] * u_old[q] + bdf[2] * u_older[q]) +
+          beta * (u[q] - mixture.grain_velocity[q]);
+        if (advection)
+          momentum += phi * rho * (grad_u[q] * u[q]);
+        for (unsigned int d = 0; d < dim; ++d)
+          momentum[d] -= f[q](d);
+        const dealii::Tensor<2, dim> viscous = phi * mu * grad_u[q];
+        const double                 continuity =
+          phi * dealii::trace(grad_u[q]) + grad_phi * u[q] +
+          mixture.solid_flux_divergence[q] - mixture.mass_source[q];
+
+        for (unsigned int i = 0; i < dofs_per_cell; ++i)
+        {
+          const double div_phi_v = phi * div_phi_u[i] + grad_phi * phi_u[i];
+          cell_rhs(i) -= (momentum * phi_u[i] +
+                          dealii::scalar_product(viscous, grad_phi_u[i]) -
+                          p[q] * div_phi_v - phi_p[i] * continuity) *
+                         JxW;
+
+          for (unsigned int j = 0; j < dofs_per_cell; ++j)
+          {
+            dealii::Tensor<1, dim> a = (mass + beta) * phi_u[j];
+            if (advection)
+            {
+              a += phi * rho * (grad_phi_u[j] * u[q]);
+              if (newton)
+                a += phi * rho * (grad_u[q] * phi_u[j]);
+            }
+            const double div_phi_uj = phi * div_phi_u[j] + grad_phi * phi_u[j];
+            cell_matrix(i, j) +=
+              (a * phi_u[i] +
+               phi * mu * dealii::scalar_product(grad_phi_u[j], grad_phi_u[i]) -
+               phi_p[j] * div_phi_v - phi_p[i] * div_phi_uj) *
+              JxW;
+          }
+        }
+
+        if (assemble_preconditioner_matrices)
+        {
+          // The Schur complement approximation (block_preconditioner.h)
+          // needs the pressure mass matrix weighted by phi/mu and the
+          // diagonal of the mass-and-drag part c M of A,
+          // c = phi rho a0/dt + beta.
+          const double mass_weight = phi / mu;
+          max_beta                 = std::max(max_beta, beta);
+          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+          {
+            const unsigned int component =
+              fe.system_to_component_index(i).first;
+            if (component == dim)
+            {
+              for (unsigned int j = 0; j < dofs_per_cell; ++j)
+                if (fe.system_to_component_index(j).first == dim)
+                  cell_mass(i, j) += mass_weight * phi_p[i] * phi_p[j] * JxW;
+            }
+            else
+              cell_reaction(i) +=
+                (mass + beta) * phi_u[i][component] * phi_u[i][component] * JxW;
+          }
+        }
+      }
+
+      // Weakly imposed pressure on open faces.
+      for (const unsigned int face_no : cell->face_indices())
+      {
+        const auto face = cell->face(face_no);
+        if (!face->at_boundary() ||
+            geometry.boundary_types[face->boundary_id()] != BoundaryType::open)
+          continue;
+        fe_face_values.reinit(cell, face_no);
+        MixtureValues<dim> face_mixture;
+        mixture_fields->evaluate(cell,
+                                 fe_face_values.get_quadrature_points(),
+                                 time,
+                                 face_mixture);
+        for (unsigned int q = 0; q < face_quadrature.size(); ++q)
+        {
+          const double p_open = parameters.open_boundary_pressure->value(
+            fe_face_values.quadrature_point(q));
+          const double weight =
+            face_mixture.fluid_fraction[q] * p_open * fe_face_values.JxW(q);
+          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+            cell_rhs(i) -= weight * (fe_face_values[velocities].value(i, q) *
+                                     fe_face_values.normal_vector(q));
+        }
+      }
+
+      cell->get_dof_indices(dof_indices);
+      update_constraints.distribute_local_to_global(
+        cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
+      if (assemble_preconditioner_matrices)
+      {
+        pressure_mass_constraints.distribute_local_to_global(
+          cell_mass, dof_indices, pressure_mass_matrix);
+        update_constraints.distribute_local_to_global(cell_reaction,
+                                                      dof_indices,
+                                                      reaction_diagonal);
+      }
+    }
 
     system_matrix.compress(dealii::VectorOperation::add);
     system_rhs.compress(dealii::VectorOperation::add);
     if (assemble_preconditioner_matrices)
-      {
-        pressure_mass_matrix.compress(dealii::VectorOperation::add);
-        pressure_laplace_matrix.compress(dealii::VectorOperation::add);
-        schur_laplace_weight =
-          dealii::Utilities::MPI::max(max_laplace_weight, mpi_communicator);
-      }
+    {
+      pressure_mass_matrix.compress(dealii::VectorOperation::add);
+      reaction_diagonal.compress(dealii::VectorOperation::add);
+      schur_has_drag =
+        dealii::Utilities::MPI::max(max_beta, mpi_communicator) > 0;
+    }
   }
 
 
-  template void FluidSolver<2>::assemble_system(bool);
-  template void FluidSolver<3>::assemble_system(bool);
+  template void
+  FluidSolver<2>::assemble_system(bool);
+  template void
+  FluidSolver<3>::assemble_system(bool);
 } // namespace ImmersedGrains

@@ -3,6 +3,7 @@
 #include <immersed_grains/fluid/fluid_parameters.h>
 
 #include <cmath>
+#include <iostream>
 #include <sstream>
 
 namespace ImmersedGrains
@@ -13,10 +14,10 @@ namespace ImmersedGrains
     // that declaration and parsing cannot drift apart.
     struct FieldEntry
     {
-      const char  *name;
-      bool         vector_valued;
-      const char  *default_value;
-      const char  *documentation;
+      const char *name;
+      bool        vector_valued;
+      const char *default_value;
+      const char *documentation;
     };
 
     const FieldEntry field_entries[] = {
@@ -73,7 +74,10 @@ namespace ImmersedGrains
                         Bool(),
                         "Solve the averaged fluid. Without it grains move in "
                         "vacuum (dry granular scenes).");
-      prm.declare_entry("Density", "1000", Double(), "Fluid density rho [kg/m^3].");
+      prm.declare_entry("Density",
+                        "1000",
+                        Double(),
+                        "Fluid density rho [kg/m^3].");
       prm.declare_entry("Viscosity",
                         "1e-3",
                         Double(),
@@ -120,9 +124,10 @@ namespace ImmersedGrains
           "Cahouet-Chabard",
           Selection("Cahouet-Chabard|pressure mass|pressure Laplacian"),
           "Approximation of the inverse Schur complement: the sum of the "
-          "phi/mu-weighted pressure mass matrix and the phi^2/(phi rho a0/dt "
-          "+ beta)-weighted pressure Laplacian (Cahouet-Chabard), or one of "
-          "its two limits.");
+          "phi/mu-weighted pressure mass matrix (viscous limit) and of "
+          "(B diag(c M)^{-1} B^T)^{-1}, c = phi rho a0/dt + beta (mass- and "
+          "drag-dominated limit; a Darcy-like pressure Laplacian), as "
+          "Cahouet-Chabard do, or either limit alone.");
         prm.declare_entry("Velocity AMG cycles",
                           "1",
                           Integer(1, 10),
@@ -132,15 +137,15 @@ namespace ImmersedGrains
       prm.leave_subsection();
 
       for (const FieldEntry &f : field_entries)
-        {
-          prm.enter_subsection(f.name);
-          dealii::Functions::ParsedFunction<dim>::declare_parameters(
-            prm, f.vector_valued ? dim : 1);
-          prm.set("Function expression",
-                  f.vector_valued ? vector_default(f.default_value, dim) :
-                                    std::string(f.default_value));
-          prm.leave_subsection();
-        }
+      {
+        prm.enter_subsection(f.name);
+        dealii::Functions::ParsedFunction<dim>::declare_parameters(
+          prm, f.vector_valued ? dim : 1);
+        prm.set("Function expression",
+                f.vector_valued ? vector_default(f.default_value, dim) :
+                                  std::string(f.default_value));
+        prm.leave_subsection();
+      }
     }
     prm.leave_subsection();
   }
@@ -175,16 +180,16 @@ namespace ImmersedGrains
 
       prm.enter_subsection("Linear solver");
       {
-        direct_solver         = prm.get("Type") == "direct";
-        linear_tolerance      = prm.get_double("Tolerance");
-        max_linear_iterations = prm.get_integer("Max iterations");
+        direct_solver           = prm.get("Type") == "direct";
+        linear_tolerance        = prm.get_double("Tolerance");
+        max_linear_iterations   = prm.get_integer("Max iterations");
         const std::string schur = prm.get("Schur complement");
-        schur_approximation =
-          schur == "pressure mass" ?
-            SchurApproximation::pressure_mass :
-            (schur == "pressure Laplacian" ? SchurApproximation::pressure_laplace :
-                                             SchurApproximation::cahouet_chabard);
-        velocity_amg_cycles = prm.get_integer("Velocity AMG cycles");
+        schur_approximation     = schur == "pressure mass" ?
+                                    SchurApproximation::pressure_mass :
+                                    (schur == "pressure Laplacian" ?
+                                       SchurApproximation::pressure_laplace :
+                                       SchurApproximation::cahouet_chabard);
+        velocity_amg_cycles     = prm.get_integer("Velocity AMG cycles");
       }
       prm.leave_subsection();
 
@@ -198,30 +203,46 @@ namespace ImmersedGrains
         &initial_velocity};
       unsigned int i = 0;
       for (const FieldEntry &f : field_entries)
-        {
-          prm.enter_subsection(f.name);
-          auto function = std::make_shared<dealii::Functions::ParsedFunction<dim>>(
+      {
+        prm.enter_subsection(f.name);
+        auto function =
+          std::make_shared<dealii::Functions::ParsedFunction<dim>>(
             f.vector_valued ? dim : 1);
+        try
+        {
+          function->parse_parameters(prm);
+          // muparser compiles an expression at its first evaluation
+          // and reports errors on std::cerr itself: evaluate once now,
+          // quietly, so that a bad expression is an input error.
+          std::ostringstream muted;
+          auto *const        cerr_buffer = std::cerr.rdbuf(muted.rdbuf());
           try
-            {
-              function->parse_parameters(prm);
-            }
-          catch (const std::exception &e)
-            {
-              std::string message = e.what();
-              if (const auto *d = dynamic_cast<const dealii::ExceptionBase *>(&e))
-                {
-                  std::ostringstream info;
-                  d->print_info(info);
-                  message = info.str();
-                }
-              where.fail(std::string(f.name) + "/Function expression",
-                         prm.get("Function expression"),
-                         message);
-            }
-          *targets[i++] = function;
-          prm.leave_subsection();
+          {
+            function->value(dealii::Point<dim>());
+          }
+          catch (...)
+          {
+            std::cerr.rdbuf(cerr_buffer);
+            throw;
+          }
+          std::cerr.rdbuf(cerr_buffer);
         }
+        catch (const std::exception &e)
+        {
+          std::string message = e.what();
+          if (const auto *d = dynamic_cast<const dealii::ExceptionBase *>(&e))
+          {
+            std::ostringstream info;
+            d->print_info(info);
+            message = info.str();
+          }
+          where.fail(std::string(f.name) + "/Function expression",
+                     prm.get("Function expression"),
+                     message);
+        }
+        *targets[i++] = function;
+        prm.leave_subsection();
+      }
     }
     prm.leave_subsection();
 
@@ -232,36 +253,37 @@ namespace ImmersedGrains
     // show as a failing solver later: sample it on a grid over the box now,
     // before anything is written.
     const unsigned int n = 16;
-    for (unsigned int k = 0; k < dealii::Utilities::fixed_power<dim>(n + 1); ++k)
+    for (unsigned int k = 0; k < dealii::Utilities::fixed_power<dim>(n + 1);
+         ++k)
+    {
+      dealii::Point<dim> p;
+      unsigned int       index = k;
+      for (unsigned int d = 0; d < dim; ++d)
       {
-        dealii::Point<dim> p;
-        unsigned int       index = k;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const double s = (index % (n + 1)) / double(n);
-            index /= (n + 1);
-            p[d] = geometry.lower_corner[d] +
-                   s * (geometry.upper_corner[d] - geometry.lower_corner[d]);
-          }
-        const double phi = fluid_fraction->value(p);
-        if (!(phi > 0 && phi <= 1))
-          {
-            std::ostringstream value;
-            value << "phi(" << p << ") = " << phi;
-            where.fail("Fluid fraction/Function expression",
-                       value.str(),
-                       "the fluid fraction must lie in (0,1]");
-          }
-        const double beta = drag_coefficient->value(p);
-        if (!(beta >= 0))
-          {
-            std::ostringstream value;
-            value << "beta(" << p << ") = " << beta;
-            where.fail("Drag coefficient/Function expression",
-                       value.str(),
-                       "the drag coefficient must be non-negative");
-          }
+        const double s = (index % (n + 1)) / double(n);
+        index /= (n + 1);
+        p[d] = geometry.lower_corner[d] +
+               s * (geometry.upper_corner[d] - geometry.lower_corner[d]);
       }
+      const double phi = fluid_fraction->value(p);
+      if (!(phi > 0 && phi <= 1))
+      {
+        std::ostringstream value;
+        value << "phi(" << p << ") = " << phi;
+        where.fail("Fluid fraction/Function expression",
+                   value.str(),
+                   "the fluid fraction must lie in (0,1]");
+      }
+      const double beta = drag_coefficient->value(p);
+      if (!(beta >= 0))
+      {
+        std::ostringstream value;
+        value << "beta(" << p << ") = " << beta;
+        where.fail("Drag coefficient/Function expression",
+                   value.str(),
+                   "the drag coefficient must be non-negative");
+      }
+    }
   }
 
 

@@ -21,9 +21,10 @@ namespace ImmersedGrains
     {
     public:
       explicit VelocityOfSystem(const dealii::Function<dim> &velocity)
-        : dealii::Function<dim>(dim + 1)
-        , velocity(velocity)
-      {}
+          : dealii::Function<dim>(dim + 1)
+          , velocity(velocity)
+      {
+      }
 
       double
       value(const dealii::Point<dim> &p, const unsigned int c) const override
@@ -43,24 +44,24 @@ namespace ImmersedGrains
     {
     public:
       MixtureFieldsOutput(const MixtureFields<dim> &fields, const double time)
-        : fields(fields)
-        , time(time)
-      {}
+          : fields(fields)
+          , time(time)
+      {
+      }
 
       void
       evaluate_vector_field(
         const dealii::DataPostprocessorInputs::Vector<dim> &inputs,
         std::vector<dealii::Vector<double>> &computed) const override
       {
-        const auto cell =
-          inputs.template get_cell<dim>();
+        const auto         cell = inputs.template get_cell<dim>();
         MixtureValues<dim> values;
         fields.evaluate(cell, inputs.evaluation_points, time, values);
         for (unsigned int q = 0; q < computed.size(); ++q)
-          {
-            computed[q](0) = values.fluid_fraction[q];
-            computed[q](1) = values.drag_coefficient[q];
-          }
+        {
+          computed[q](0) = values.fluid_fraction[q];
+          computed[q](1) = values.drag_coefficient[q];
+        }
       }
 
       std::vector<std::string>
@@ -89,16 +90,16 @@ namespace ImmersedGrains
     dealii::parallel::distributed::Triangulation<dim> &triangulation,
     dealii::TimerOutput                               &timer,
     dealii::ConditionalOStream                        &pcout)
-    : parameters(parameters)
-    , geometry(geometry)
-    , triangulation(triangulation)
-    , timer(timer)
-    , pcout(pcout)
-    , mpi_communicator(triangulation.get_communicator())
-    , fe(dealii::FE_Q<dim>(2), dim, dealii::FE_Q<dim>(1), 1)
-    , dof_handler(triangulation)
-    , forcing(parameters.forcing)
-    , boundary_velocity(parameters.boundary_velocity)
+      : parameters(parameters)
+      , geometry(geometry)
+      , triangulation(triangulation)
+      , timer(timer)
+      , pcout(pcout)
+      , mpi_communicator(triangulation.get_communicator())
+      , fe(dealii::FE_Q<dim>(2), dim, dealii::FE_Q<dim>(1), 1)
+      , dof_handler(triangulation)
+      , forcing(parameters.forcing)
+      , boundary_velocity(parameters.boundary_velocity)
   {
     mixture_fields = std::make_shared<PrescribedMixtureFields<dim>>(
       parameters.fluid_fraction,
@@ -189,31 +190,28 @@ namespace ImmersedGrains
         for (unsigned int d = 0; d < dim + 1; ++d)
           coupling[c][d] = (c == dim && d == dim) ? dealii::DoFTools::always :
                                                     dealii::DoFTools::none;
-      // Each matrix is built with the constraints it is assembled with.
-      for (auto *matrix : {&pressure_mass_matrix, &pressure_laplace_matrix})
-        {
-          dealii::TrilinosWrappers::BlockSparsityPattern sp(
-            owned_partitioning,
-            owned_partitioning,
-            relevant_partitioning,
-            mpi_communicator);
-          dealii::DoFTools::make_sparsity_pattern(
-            dof_handler,
-            coupling,
-            sp,
-            matrix == &pressure_mass_matrix ? pressure_mass_constraints :
-                                              pressure_laplace_constraints,
-            false,
-            dealii::Utilities::MPI::this_mpi_process(mpi_communicator));
-          sp.compress();
-          matrix->reinit(sp);
-        }
+      dealii::TrilinosWrappers::BlockSparsityPattern sp(owned_partitioning,
+                                                        owned_partitioning,
+                                                        relevant_partitioning,
+                                                        mpi_communicator);
+      dealii::DoFTools::make_sparsity_pattern(
+        dof_handler,
+        coupling,
+        sp,
+        pressure_mass_constraints,
+        false,
+        dealii::Utilities::MPI::this_mpi_process(mpi_communicator));
+      sp.compress();
+      pressure_mass_matrix.reinit(sp);
     }
 
-    solution.reinit(owned_partitioning, relevant_partitioning, mpi_communicator);
+    solution.reinit(owned_partitioning,
+                    relevant_partitioning,
+                    mpi_communicator);
     old_solution.reinit(solution);
     old_old_solution.reinit(solution);
     system_rhs.reinit(owned_partitioning, mpi_communicator);
+    reaction_diagonal.reinit(owned_partitioning, mpi_communicator);
     newton_update.reinit(owned_partitioning, mpi_communicator);
     preconditioner.reset();
   }
@@ -226,7 +224,6 @@ namespace ImmersedGrains
     dealii::IndexSet relevant;
     dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
     const dealii::FEValuesExtractors::Vector velocities(0);
-    const dealii::FEValuesExtractors::Scalar pressure(dim);
     const auto velocity_mask = fe.component_mask(velocities);
 
     std::set<dealii::types::boundary_id> slip_faces;
@@ -235,61 +232,53 @@ namespace ImmersedGrains
         slip_faces.insert(f);
 
     boundary_velocity->set_time(time);
-    const VelocityOfSystem<dim>               prescribed(*boundary_velocity);
+    const VelocityOfSystem<dim>                prescribed(*boundary_velocity);
     const dealii::Functions::ZeroFunction<dim> zero(dim + 1);
 
     // Same structure, two right-hand sides: the solution carries the
     // boundary data, the update is zero wherever the solution is fixed.
     for (const bool homogeneous : {false, true})
+    {
+      auto &c = homogeneous ? update_constraints : solution_constraints;
+      c.clear();
+      c.reinit(relevant);
+      dealii::DoFTools::make_hanging_node_constraints(dof_handler, c);
+      for (unsigned int d = 0; d < dim; ++d)
+        if (geometry.is_periodic(d))
+          dealii::DoFTools::make_periodicity_constraints(
+            dof_handler, 2 * d, 2 * d + 1, d, c);
+      for (unsigned int f = 0; f < 2 * dim; ++f)
       {
-        auto &c = homogeneous ? update_constraints : solution_constraints;
-        c.clear();
-        c.reinit(relevant);
-        dealii::DoFTools::make_hanging_node_constraints(dof_handler, c);
-        for (unsigned int d = 0; d < dim; ++d)
-          if (geometry.is_periodic(d))
-            dealii::DoFTools::make_periodicity_constraints(
-              dof_handler, 2 * d, 2 * d + 1, d, c);
-        for (unsigned int f = 0; f < 2 * dim; ++f)
-          {
-            if (geometry.boundary_types[f] == BoundaryType::wall)
-              dealii::VectorTools::interpolate_boundary_values(
-                mapping, dof_handler, f, zero, c, velocity_mask);
-            else if (geometry.boundary_types[f] == BoundaryType::velocity)
-              dealii::VectorTools::interpolate_boundary_values(
-                mapping,
-                dof_handler,
-                f,
-                homogeneous ? static_cast<const dealii::Function<dim> &>(zero) :
-                              prescribed,
-                c,
-                velocity_mask);
-          }
-        if (!slip_faces.empty())
-          dealii::VectorTools::compute_no_normal_flux_constraints(
-            dof_handler, 0, slip_faces, c, mapping);
-        c.close();
+        if (geometry.boundary_types[f] == BoundaryType::wall)
+          dealii::VectorTools::interpolate_boundary_values(
+            mapping, dof_handler, f, zero, c, velocity_mask);
+        else if (geometry.boundary_types[f] == BoundaryType::velocity)
+          dealii::VectorTools::interpolate_boundary_values(
+            mapping,
+            dof_handler,
+            f,
+            homogeneous ? static_cast<const dealii::Function<dim> &>(zero) :
+                          prescribed,
+            c,
+            velocity_mask);
       }
+      if (!slip_faces.empty())
+        dealii::VectorTools::compute_no_normal_flux_constraints(
+          dof_handler, 0, slip_faces, c, mapping);
+      c.close();
+    }
 
-    for (auto *c : {&pressure_mass_constraints, &pressure_laplace_constraints})
-      {
-        c->clear();
-        c->reinit(relevant);
-        dealii::DoFTools::make_hanging_node_constraints(dof_handler, *c);
-        for (unsigned int d = 0; d < dim; ++d)
-          if (geometry.is_periodic(d))
-            dealii::DoFTools::make_periodicity_constraints(
-              dof_handler, 2 * d, 2 * d + 1, d, *c);
-      }
+    // The pressure mass matrix only needs the constraints that tie pressure
+    // DoFs together.
+    pressure_mass_constraints.clear();
+    pressure_mass_constraints.reinit(relevant);
+    dealii::DoFTools::make_hanging_node_constraints(dof_handler,
+                                                    pressure_mass_constraints);
+    for (unsigned int d = 0; d < dim; ++d)
+      if (geometry.is_periodic(d))
+        dealii::DoFTools::make_periodicity_constraints(
+          dof_handler, 2 * d, 2 * d + 1, d, pressure_mass_constraints);
     pressure_mass_constraints.close();
-    // Where the pressure is imposed, the Schur complement of the
-    // mass/drag-dominated limit is a Laplacian with Dirichlet data.
-    for (unsigned int f = 0; f < 2 * dim; ++f)
-      if (geometry.boundary_types[f] == BoundaryType::open)
-        dealii::VectorTools::interpolate_boundary_values(
-          mapping, dof_handler, f, zero, pressure_laplace_constraints,
-          fe.component_mask(pressure));
-    pressure_laplace_constraints.close();
   }
 
 
@@ -327,8 +316,10 @@ namespace ImmersedGrains
   {
     if (!pressure_has_null_space())
       return;
-    VectorType ghosted(owned_partitioning, relevant_partitioning, mpi_communicator);
-    ghosted = vector;
+    VectorType ghosted(owned_partitioning,
+                       relevant_partitioning,
+                       mpi_communicator);
+    ghosted           = vector;
     const double mean = dealii::VectorTools::compute_mean_value(
       mapping, dof_handler, dealii::QGauss<dim>(3), ghosted, dim);
     vector.block(1).add(-mean);
@@ -366,40 +357,42 @@ namespace ImmersedGrains
     VectorType iterate(owned_partitioning, mpi_communicator);
     iterate = old_solution;
     if (second_order && parameters.time_derivative)
-      {
-        iterate *= (1 + omega);
-        VectorType older(owned_partitioning, mpi_communicator);
-        older = old_old_solution;
-        iterate.add(-omega, older);
-      }
+    {
+      iterate *= (1 + omega);
+      VectorType older(owned_partitioning, mpi_communicator);
+      older = old_old_solution;
+      iterate.add(-omega, older);
+    }
     solution_constraints.distribute(iterate);
     solution = iterate;
 
     StepStatistics stats;
     const bool     linear = !parameters.advection;
     for (unsigned int k = 0; k < parameters.max_nonlinear_iterations; ++k)
-      {
-        assemble_system(true);
-        const double residual = system_rhs.l2_norm();
-        if (k == 0)
-          stats.initial_residual = residual;
-        stats.final_residual = residual;
-        if (k > 0 && residual <= parameters.nonlinear_tolerance *
-                                    std::max(stats.initial_residual, 1e-300))
-          break;
-        if (residual == 0)
-          break;
+    {
+      assemble_system(true);
+      const double residual = system_rhs.l2_norm();
+      if (k == 0)
+        stats.initial_residual = residual;
+      stats.final_residual = residual;
+      if (k > 0 && residual <= parameters.nonlinear_tolerance *
+                                 std::max(stats.initial_residual, 1e-300))
+        break;
+      if (residual == 0)
+        break;
 
-        stats.linear_iterations += solve_linear_system();
-        ++stats.nonlinear_iterations;
-        update_constraints.distribute(newton_update);
-        iterate.add(1.0, newton_update);
-        solution = iterate;
-        if (linear)
-          break;
-      }
-    AssertThrow(linear || stats.nonlinear_iterations <
-                            parameters.max_nonlinear_iterations ||
+      stats.linear_iterations += solve_linear_system(
+        0.1 * parameters.nonlinear_tolerance * stats.initial_residual);
+      ++stats.nonlinear_iterations;
+      update_constraints.distribute(newton_update);
+      iterate.add(1.0, newton_update);
+      solution = iterate;
+      if (linear)
+        break;
+    }
+    AssertThrow(linear ||
+                  stats.nonlinear_iterations <
+                    parameters.max_nonlinear_iterations ||
                   stats.final_residual <=
                     parameters.nonlinear_tolerance * stats.initial_residual,
                 dealii::ExcMessage(
@@ -433,16 +426,16 @@ namespace ImmersedGrains
                                         dealii::update_JxW_values);
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          for (unsigned int q = 0; q < quadrature.size(); ++q)
           {
-            fe_values.reinit(cell);
-            for (unsigned int q = 0; q < quadrature.size(); ++q)
-              {
-                exact_mean += exact_solution.value(
-                                fe_values.quadrature_point(q), dim) *
-                              fe_values.JxW(q);
-                volume += fe_values.JxW(q);
-              }
+            exact_mean +=
+              exact_solution.value(fe_values.quadrature_point(q), dim) *
+              fe_values.JxW(q);
+            volume += fe_values.JxW(q);
           }
+        }
       exact_mean = dealii::Utilities::MPI::sum(exact_mean, mpi_communicator);
       volume     = dealii::Utilities::MPI::sum(volume, mpi_communicator);
       exact_mean /= volume;
@@ -454,10 +447,11 @@ namespace ImmersedGrains
     {
     public:
       Shifted(const dealii::Function<dim> &f, const double shift)
-        : dealii::Function<dim>(dim + 1)
-        , f(f)
-        , shift(shift)
-      {}
+          : dealii::Function<dim>(dim + 1)
+          , f(f)
+          , shift(shift)
+      {
+      }
       double
       value(const dealii::Point<dim> &p, const unsigned int c) const override
       {
@@ -488,8 +482,10 @@ namespace ImmersedGrains
                                               quadrature,
                                               dealii::VectorTools::L2_norm,
                                               &velocity_mask);
-    errors[0] = dealii::VectorTools::compute_global_error(
-      triangulation, cellwise, dealii::VectorTools::L2_norm);
+    errors[0] =
+      dealii::VectorTools::compute_global_error(triangulation,
+                                                cellwise,
+                                                dealii::VectorTools::L2_norm);
     dealii::VectorTools::integrate_difference(mapping,
                                               dof_handler,
                                               solution,
@@ -508,8 +504,10 @@ namespace ImmersedGrains
                                               quadrature,
                                               dealii::VectorTools::L2_norm,
                                               &pressure_mask);
-    errors[2] = dealii::VectorTools::compute_global_error(
-      triangulation, cellwise, dealii::VectorTools::L2_norm);
+    errors[2] =
+      dealii::VectorTools::compute_global_error(triangulation,
+                                                cellwise,
+                                                dealii::VectorTools::L2_norm);
     return errors;
   }
 
@@ -520,14 +518,13 @@ namespace ImmersedGrains
   {
     std::vector<std::string> names(dim, "velocity");
     names.emplace_back("pressure");
-    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
-      interpretation(dim,
-                     dealii::DataComponentInterpretation::component_is_part_of_vector);
-    interpretation.push_back(dealii::DataComponentInterpretation::component_is_scalar);
-    data_out.add_data_vector(dof_handler,
-                             solution,
-                             names,
-                             interpretation);
+    std::vector<
+      dealii::DataComponentInterpretation::DataComponentInterpretation>
+      interpretation(
+        dim, dealii::DataComponentInterpretation::component_is_part_of_vector);
+    interpretation.push_back(
+      dealii::DataComponentInterpretation::component_is_scalar);
+    data_out.add_data_vector(dof_handler, solution, names, interpretation);
     output_fields =
       std::make_unique<MixtureFieldsOutput<dim>>(*mixture_fields, time);
     data_out.add_data_vector(dof_handler, solution, *output_fields);
@@ -548,15 +545,15 @@ namespace ImmersedGrains
     double                    integral = 0;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
-        {
-          fe_values.reinit(cell);
-          mixture_fields->evaluate(cell,
-                                   fe_values.get_quadrature_points(),
-                                   time,
-                                   values);
-          for (unsigned int q = 0; q < quadrature.size(); ++q)
-            integral += values.fluid_fraction[q] * fe_values.JxW(q);
-        }
+      {
+        fe_values.reinit(cell);
+        mixture_fields->evaluate(cell,
+                                 fe_values.get_quadrature_points(),
+                                 time,
+                                 values);
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          integral += values.fluid_fraction[q] * fe_values.JxW(q);
+      }
     return dealii::Utilities::MPI::sum(integral, mpi_communicator);
   }
 

@@ -21,11 +21,12 @@ namespace ImmersedGrains
     std::shared_ptr<dealii::Function<dim>> drag_coefficient,
     std::shared_ptr<dealii::Function<dim>> grain_velocity,
     std::shared_ptr<dealii::Function<dim>> mass_source)
-    : fluid_fraction(fluid_fraction)
-    , drag_coefficient(drag_coefficient)
-    , grain_velocity(grain_velocity)
-    , mass_source(mass_source)
-  {}
+      : fluid_fraction(fluid_fraction)
+      , drag_coefficient(drag_coefficient)
+      , grain_velocity(grain_velocity)
+      , mass_source(mass_source)
+  {
+  }
 
 
   template <int dim>
@@ -45,25 +46,25 @@ namespace ImmersedGrains
       mass_source->set_time(time);
 
     for (unsigned int q = 0; q < n; ++q)
-      {
-        const auto &x                     = points[q];
-        const double phi                  = fluid_fraction->value(x);
-        const auto   grad_phi             = fluid_fraction->gradient(x);
-        values.fluid_fraction[q]          = phi;
-        values.fluid_fraction_gradient[q] = grad_phi;
-        values.drag_coefficient[q]        = drag_coefficient->value(x);
+    {
+      const auto  &x                    = points[q];
+      const double phi                  = fluid_fraction->value(x);
+      const auto   grad_phi             = fluid_fraction->gradient(x);
+      values.fluid_fraction[q]          = phi;
+      values.fluid_fraction_gradient[q] = grad_phi;
+      values.drag_coefficient[q]        = drag_coefficient->value(x);
 
-        // div((1 - phi) u_p) = (1 - phi) div u_p - grad(phi) . u_p
-        double div_up = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            values.grain_velocity[q][d] = grain_velocity->value(x, d);
-            div_up += grain_velocity->gradient(x, d)[d];
-          }
-        values.solid_flux_divergence[q] =
-          (1 - phi) * div_up - grad_phi * values.grain_velocity[q];
-        values.mass_source[q] = mass_source ? mass_source->value(x) : 0.0;
+      // div((1 - phi) u_p) = (1 - phi) div u_p - grad(phi) . u_p
+      double div_up = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        values.grain_velocity[q][d] = grain_velocity->value(x, d);
+        div_up += grain_velocity->gradient(x, d)[d];
       }
+      values.solid_flux_divergence[q] =
+        (1 - phi) * div_up - grad_phi * values.grain_velocity[q];
+      values.mass_source[q] = mass_source ? mass_source->value(x) : 0.0;
+    }
   }
 
 

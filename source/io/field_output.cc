@@ -8,18 +8,19 @@ namespace ImmersedGrains
 {
   template <int dim>
   FieldOutput<dim>::FieldOutput(const std::string &directory, MPI_Comm comm)
-    : directory(directory)
-    , comm(comm)
-  {}
+      : directory(directory)
+      , comm(comm)
+  {
+  }
 
 
   template <int dim>
   void
   FieldOutput<dim>::write(
     const dealii::parallel::distributed::Triangulation<dim> &tria,
-    const double                                              time,
-    const unsigned int                                        step,
-    const std::function<void(dealii::DataOut<dim> &)>        &add_fields)
+    const double                                             time,
+    const unsigned int                                       step,
+    const std::function<void(dealii::DataOut<dim> &)>       &add_fields)
   {
     dealii::DataOut<dim> data_out;
     data_out.attach_triangulation(tria);
@@ -29,16 +30,16 @@ namespace ImmersedGrains
     dealii::Vector<float> level(tria.n_active_cells());
     for (const auto &cell : tria.active_cell_iterators())
       if (cell->is_locally_owned())
-        {
-          rank(cell->active_cell_index())  = tria.locally_owned_subdomain();
-          level(cell->active_cell_index()) = cell->level();
-        }
+      {
+        rank(cell->active_cell_index())  = tria.locally_owned_subdomain();
+        level(cell->active_cell_index()) = cell->level();
+      }
     data_out.add_data_vector(rank, "mpi_rank");
     data_out.add_data_vector(level, "refinement_level");
 
     dealii::DataOutBase::VtkFlags flags;
-    flags.time  = time;
-    flags.cycle = step;
+    flags.time              = time;
+    flags.cycle             = step;
     flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
     data_out.set_flags(flags);
     data_out.build_patches(2);
@@ -47,10 +48,10 @@ namespace ImmersedGrains
       directory + "/", "fields", step, comm, 5, 8);
     records.emplace_back(time, master);
     if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-      {
-        std::ofstream pvd(directory + "/fields.pvd");
-        dealii::DataOutBase::write_pvd_record(pvd, records);
-      }
+    {
+      std::ofstream pvd(directory + "/fields.pvd");
+      dealii::DataOutBase::write_pvd_record(pvd, records);
+    }
   }
 
 

@@ -7,8 +7,9 @@
 namespace ImmersedGrains
 {
   RunLog::RunLog()
-    : out(&buffer)
-  {}
+      : out(&buffer)
+  {
+  }
 
 
   RunLog::~RunLog()
@@ -18,7 +19,9 @@ namespace ImmersedGrains
 
 
   void
-  RunLog::open(const std::string &file_name, const bool is_root, const bool echo)
+  RunLog::open(const std::string &file_name,
+               const bool         is_root,
+               const bool         echo)
   {
     if (!is_root)
       return;

@@ -8,7 +8,7 @@
 namespace ImmersedGrains
 {
   Statistics::Statistics(std::vector<std::string> columns)
-    : columns(std::move(columns))
+      : columns(std::move(columns))
   {
     for (const auto &c : this->columns)
       values[c] = 0;
@@ -73,13 +73,13 @@ namespace ImmersedGrains
   {
     out << std::setprecision(6);
     for (unsigned int i = 0; i < selected.size(); ++i)
-      {
-        double v = get(selected[i]);
-        // Round-off around zero is not a difference between machines.
-        if (std::abs(v) < 1e-300)
-          v = 0;
-        out << (i ? " " : "") << selected[i] << "=" << v;
-      }
+    {
+      double v = get(selected[i]);
+      // Round-off around zero is not a difference between machines.
+      if (std::abs(v) < 1e-300)
+        v = 0;
+      out << (i ? " " : "") << selected[i] << "=" << v;
+    }
     out << std::endl;
   }
 

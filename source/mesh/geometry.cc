@@ -10,18 +10,18 @@ namespace ImmersedGrains
   to_string(const BoundaryType type)
   {
     switch (type)
-      {
-        case BoundaryType::wall:
-          return "wall";
-        case BoundaryType::slip:
-          return "slip";
-        case BoundaryType::open:
-          return "open";
-        case BoundaryType::velocity:
-          return "velocity";
-        case BoundaryType::periodic:
-          return "periodic";
-      }
+    {
+      case BoundaryType::wall:
+        return "wall";
+      case BoundaryType::slip:
+        return "slip";
+      case BoundaryType::open:
+        return "open";
+      case BoundaryType::velocity:
+        return "velocity";
+      case BoundaryType::periodic:
+        return "periodic";
+    }
     return "?";
   }
 
@@ -53,7 +53,8 @@ namespace ImmersedGrains
                         "Global refinements of the coarse mesh.");
       prm.declare_entry(
         "Boundary conditions",
-        dim == 2 ? "wall, wall, wall, wall" : "wall, wall, wall, wall, wall, wall",
+        dim == 2 ? "wall, wall, wall, wall" :
+                   "wall, wall, wall, wall, wall, wall",
         Anything(),
         "One entry per face in the order x-min, x-max, y-min, y-max[, z-min, "
         "z-max] (boundary ids 0..2dim-1): wall (no-slip), slip (no normal "
@@ -83,27 +84,26 @@ namespace ImmersedGrains
                       "must be above Lower corner (" + prm.get("Lower corner") +
                         ") in every coordinate");
 
-      const auto n = parse_double_list(prm.get("Subdivisions"),
-                                       where,
-                                       "Subdivisions");
+      const auto n =
+        parse_double_list(prm.get("Subdivisions"), where, "Subdivisions");
       where.require(n.size() == 1 || n.size() == dim,
                     "Subdivisions",
                     prm.get("Subdivisions"),
                     "give one number or one per direction");
       subdivisions.clear();
       for (unsigned int d = 0; d < dim; ++d)
-        {
-          const double v = n.size() == 1 ? n[0] : n[d];
-          where.require(v >= 1 && v == std::floor(v) && v < 1e6,
-                        "Subdivisions",
-                        prm.get("Subdivisions"),
-                        "must be positive integers");
-          subdivisions.push_back(static_cast<unsigned int>(v));
-        }
+      {
+        const double v = n.size() == 1 ? n[0] : n[d];
+        where.require(v >= 1 && v == std::floor(v) && v < 1e6,
+                      "Subdivisions",
+                      prm.get("Subdivisions"),
+                      "must be positive integers");
+        subdivisions.push_back(static_cast<unsigned int>(v));
+      }
       initial_refinement = prm.get_integer("Initial refinement");
 
       const std::string bc_text = prm.get("Boundary conditions");
-      const auto entries = dealii::Utilities::split_string_list(bc_text);
+      const auto        entries = dealii::Utilities::split_string_list(bc_text);
       where.require(entries.size() == 2 * dim,
                     "Boundary conditions",
                     bc_text,
@@ -112,23 +112,23 @@ namespace ImmersedGrains
                       std::to_string(entries.size()));
       boundary_types.clear();
       for (const std::string &e : entries)
-        {
-          if (e == "wall")
-            boundary_types.push_back(BoundaryType::wall);
-          else if (e == "slip")
-            boundary_types.push_back(BoundaryType::slip);
-          else if (e == "open")
-            boundary_types.push_back(BoundaryType::open);
-          else if (e == "velocity")
-            boundary_types.push_back(BoundaryType::velocity);
-          else if (e == "periodic")
-            boundary_types.push_back(BoundaryType::periodic);
-          else
-            where.fail("Boundary conditions",
-                       bc_text,
-                       "unknown type '" + e +
-                         "' (wall, slip, open, velocity, periodic)");
-        }
+      {
+        if (e == "wall")
+          boundary_types.push_back(BoundaryType::wall);
+        else if (e == "slip")
+          boundary_types.push_back(BoundaryType::slip);
+        else if (e == "open")
+          boundary_types.push_back(BoundaryType::open);
+        else if (e == "velocity")
+          boundary_types.push_back(BoundaryType::velocity);
+        else if (e == "periodic")
+          boundary_types.push_back(BoundaryType::periodic);
+        else
+          where.fail("Boundary conditions",
+                     bc_text,
+                     "unknown type '" + e +
+                       "' (wall, slip, open, velocity, periodic)");
+      }
       for (unsigned int d = 0; d < dim; ++d)
         where.require((boundary_types[2 * d] == BoundaryType::periodic) ==
                         (boundary_types[2 * d + 1] == BoundaryType::periodic),
@@ -169,7 +169,8 @@ namespace ImmersedGrains
       tria, subdivisions, lower_corner, upper_corner, /*colorize=*/true);
 
     std::vector<dealii::GridTools::PeriodicFacePair<
-      typename dealii::parallel::distributed::Triangulation<dim>::cell_iterator>>
+      typename dealii::parallel::distributed::Triangulation<
+        dim>::cell_iterator>>
       periodic_faces;
     for (unsigned int d = 0; d < dim; ++d)
       if (is_periodic(d))

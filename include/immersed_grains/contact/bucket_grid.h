@@ -89,12 +89,14 @@ namespace ImmersedGrains
       Tensor<1, dim>                bucket_size;
 
       // Work arrays, grains sorted by bucket (counting sort).
-      std::vector<unsigned int> bucket_of_grain;
-      std::vector<unsigned int> bucket_start;
-      std::vector<unsigned int> grain_in_order;
-      std::vector<Point<dim>>   wrapped_position;
+      std::vector<unsigned int>         bucket_of_grain;
+      std::vector<unsigned int>         bucket_start;
+      std::vector<unsigned int>         grain_in_order;
+      std::vector<Point<dim>>           wrapped_position;
+      std::vector<double>               sorted_radius;
       std::vector<std::array<int, dim>> wrap_count;
       std::vector<unsigned int>         sort_buffer;
+      std::vector<unsigned int>         by_first;
       std::vector<unsigned int>         sort_count;
       std::vector<GrainPair<dim>>       unsorted_pairs;
 
@@ -102,7 +104,8 @@ namespace ImmersedGrains
       choose_buckets(const unsigned int n_grains, const double min_size);
 
       void
-      sort_grains_into_buckets(const std::vector<Point<dim>> &positions);
+      sort_grains_into_buckets(const std::vector<Point<dim>> &positions,
+                               const std::vector<double>     &radii);
 
       void
       sort_pairs_by_index(const unsigned int           n_grains,

@@ -269,11 +269,22 @@ namespace ImmersedGrains
 
       std::vector<CachedImpulse> cache;
 
+      // Contact m of the lists given to setup() (pairs, then walls) is row
+      // row_of_input[m] of the work arrays, which are in sweep order.
+      std::vector<unsigned int> row_of_input;
+      std::vector<unsigned int> rank_count;
+      std::vector<unsigned int> round_start;
+
       ContactImpulses<dim> pair_results;
       ContactImpulses<dim> wall_results;
 
       void
-      add_row(const unsigned int      i,
+      order_rows(const std::vector<GrainPair<dim>>   &pairs,
+                 const std::vector<WallContact<dim>> &wall_contacts);
+
+      void
+      set_row(const unsigned int      k,
+              const unsigned int      i,
               const unsigned int      j,
               const Tensor<1, dim>   &normal,
               const double            gap,
@@ -283,9 +294,9 @@ namespace ImmersedGrains
       warm_start();
 
       void
-      apply_impulse(const unsigned int    k,
-                    const double          dp_n,
-                    const double         *dp_t);
+      apply_impulse(const unsigned int k,
+                    const double       dp_n,
+                    const double      *dp_t);
 
       template <bool with_friction>
       SweepResult

@@ -79,8 +79,8 @@ namespace ImmersedGrains
        * numbers::invalid_unsigned_int where no wall was added.
        */
       std::array<unsigned int, 2 * dim>
-      add_box(const Point<dim>                  &lower,
-              const Point<dim>                  &upper,
+      add_box(const Point<dim>                &lower,
+              const Point<dim>                &upper,
               const std::array<bool, 2 * dim> &is_wall);
 
       void
@@ -102,13 +102,13 @@ namespace ImmersedGrains
        * through a wall gets a negative gap, so the solver pushes it back.
        */
       void
-      find_contacts(const std::vector<Point<dim>>  &positions,
-                    const std::vector<double>      &radii,
-                    const double                    alert_distance,
+      find_contacts(const std::vector<Point<dim>> &positions,
+                    const std::vector<double>     &radii,
+                    const double                   alert_distance,
                     std::vector<WallContact<dim>> &contacts) const;
 
     private:
-      std::vector<PlaneWall<dim>>  planes;
+      std::vector<PlaneWall<dim>> planes;
       std::vector<Tensor<1, dim>> wall_velocities;
     };
   } // namespace Contact

@@ -17,11 +17,11 @@ namespace ImmersedGrains
    *
    * applied as p = -S~^{-1} g, u = A~^{-1}(f - B^T p). A~^{-1} is one or
    * more AMG V-cycles on the velocity block. S~^{-1} is the Cahouet-Chabard
-   * sum M_w^{-1} + L_k^{-1} of a pressure mass matrix weighted by phi/mu
-   * (the viscous limit of S) and a pressure Laplacian weighted by
-   * phi^2/(phi rho a0/dt + beta) (the mass- and drag-dominated limit), each
-   * approximated by one application of ILU (mass) or AMG (Laplacian); either
-   * term may be left out. doc/theory.md motivates the weights.
+   * sum M_w^{-1} + S_c^{-1} of a pressure mass matrix weighted by phi/mu
+   * (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T, the limit where
+   * mass and drag c = phi rho a0/dt + beta dominate, each approximated by
+   * one application of ILU (mass) or AMG (S_c); either term may be left
+   * out. doc/theory.md motivates the choice.
    */
   class BlockSchurPreconditioner
   {
@@ -31,6 +31,7 @@ namespace ImmersedGrains
     struct Settings
     {
       unsigned int velocity_cycles = 1;
+
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
     };

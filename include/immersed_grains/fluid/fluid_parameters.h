@@ -45,11 +45,12 @@ namespace ImmersedGrains
     double       nonlinear_tolerance      = 1e-8;
     unsigned int max_nonlinear_iterations = 20;
 
-    bool               direct_solver          = false;
-    double             linear_tolerance       = 1e-8;
-    unsigned int       max_linear_iterations  = 500;
-    SchurApproximation schur_approximation    = SchurApproximation::cahouet_chabard;
-    unsigned int       velocity_amg_cycles    = 1;
+    bool               direct_solver         = false;
+    double             linear_tolerance      = 1e-8;
+    unsigned int       max_linear_iterations = 500;
+    SchurApproximation schur_approximation =
+      SchurApproximation::cahouet_chabard;
+    unsigned int velocity_amg_cycles = 1;
 
     // Prescribed fields; shared so that a test can substitute exact ones.
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> fluid_fraction;
@@ -57,7 +58,8 @@ namespace ImmersedGrains
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> grain_velocity;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> forcing;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> boundary_velocity;
-    std::shared_ptr<dealii::Functions::ParsedFunction<dim>> open_boundary_pressure;
+    std::shared_ptr<dealii::Functions::ParsedFunction<dim>>
+      open_boundary_pressure;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> initial_velocity;
   };
 } // namespace ImmersedGrains

@@ -45,11 +45,12 @@ namespace ImmersedGrains
     using VectorType = dealii::TrilinosWrappers::MPI::BlockVector;
     using MatrixType = dealii::TrilinosWrappers::BlockSparseMatrix;
 
-    FluidSolver(const FluidParameters<dim>                        &parameters,
-                const Geometry<dim>                               &geometry,
-                dealii::parallel::distributed::Triangulation<dim> &triangulation,
-                dealii::TimerOutput                               &timer,
-                dealii::ConditionalOStream                        &pcout);
+    FluidSolver(
+      const FluidParameters<dim>                        &parameters,
+      const Geometry<dim>                               &geometry,
+      dealii::parallel::distributed::Triangulation<dim> &triangulation,
+      dealii::TimerOutput                               &timer,
+      dealii::ConditionalOStream                        &pcout);
     ~FluidSolver();
 
     /** Distributes DoFs, builds constraints and sparsity. */
@@ -113,7 +114,7 @@ namespace ImmersedGrains
     assemble_system(bool assemble_preconditioner_matrices);
 
     unsigned int
-    solve_linear_system();
+    solve_linear_system(double absolute_tolerance);
 
     void
     build_preconditioner();
@@ -124,52 +125,53 @@ namespace ImmersedGrains
     bool
     pressure_has_null_space() const;
 
-    const FluidParameters<dim> &parameters;
-    const Geometry<dim>        &geometry;
+    const FluidParameters<dim>                        &parameters;
+    const Geometry<dim>                               &geometry;
     dealii::parallel::distributed::Triangulation<dim> &triangulation;
     dealii::TimerOutput                               &timer;
     dealii::ConditionalOStream                        &pcout;
     MPI_Comm                                           mpi_communicator;
 
-    dealii::FESystem<dim>     fe;
-    dealii::DoFHandler<dim>   dof_handler;
-    dealii::MappingQ1<dim>    mapping;
+    dealii::FESystem<dim>         fe;
+    dealii::DoFHandler<dim>       dof_handler;
+    dealii::MappingQ1<dim>        mapping;
     std::vector<dealii::IndexSet> owned_partitioning;
     std::vector<dealii::IndexSet> relevant_partitioning;
 
-    // Constraints of the solution (inhomogeneous Dirichlet data) and of the
-    // Newton/Picard update (homogeneous), and those of the pressure Laplacian
-    // of the Schur preconditioner (pressure fixed on open faces).
+    // Constraints of the solution (inhomogeneous Dirichlet data), of the
+    // Newton/Picard update (homogeneous), and of the pressure mass matrix.
     dealii::AffineConstraints<double> solution_constraints;
     dealii::AffineConstraints<double> update_constraints;
     dealii::AffineConstraints<double> pressure_mass_constraints;
-    dealii::AffineConstraints<double> pressure_laplace_constraints;
 
     MatrixType system_matrix;
-    MatrixType pressure_mass_matrix;    // block (1,1) used
-    MatrixType pressure_laplace_matrix; // block (1,1) used
+    MatrixType pressure_mass_matrix; // block (1,1) used
+    // Diagonal of the mass-and-drag part of the velocity block, and the
+    // Schur complement approximation B diag^{-1} B^T built from it.
+    VectorType                             reaction_diagonal; // block 0 used
+    dealii::TrilinosWrappers::SparseMatrix schur_diagonal_matrix;
 
-    VectorType solution;           // ghosted, current iterate / new time
-    VectorType old_solution;       // ghosted, t^n
-    VectorType old_old_solution;   // ghosted, t^{n-1}
-    VectorType system_rhs;         // owned: minus the residual
-    VectorType newton_update;      // owned
+    VectorType solution;         // ghosted, current iterate / new time
+    VectorType old_solution;     // ghosted, t^n
+    VectorType old_old_solution; // ghosted, t^{n-1}
+    VectorType system_rhs;       // owned: minus the residual
+    VectorType newton_update;    // owned
 
     std::shared_ptr<const MixtureFields<dim>> mixture_fields;
     std::shared_ptr<dealii::Function<dim>>    forcing;
     std::shared_ptr<dealii::Function<dim>>    boundary_velocity;
 
-    double       time          = 0;
-    double       dt            = 0;
-    double       old_dt        = 0;
-    unsigned int steps_done    = 0;
+    double       time       = 0;
+    double       dt         = 0;
+    double       old_dt     = 0;
+    unsigned int steps_done = 0;
     // BDF coefficients of u^{n+1}, u^n, u^{n-1} (divided by dt when used).
     std::array<double, 3> bdf = {{0, 0, 0}};
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
-    // Largest weight of the pressure Laplacian; zero when neither inertia
-    // nor drag is present (steady Stokes), and the term is then left out.
-    double schur_laplace_weight = 0;
+    // Whether any drag is present; without it and without inertia (steady
+    // Stokes) the Laplacian term of the Schur approximation is left out.
+    bool schur_has_drag = false;
 
     // DataOut keeps a pointer to the postprocessor until patches are built.
     mutable std::unique_ptr<dealii::DataPostprocessor<dim>> output_fields;

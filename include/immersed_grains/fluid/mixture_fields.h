@@ -44,10 +44,11 @@ namespace ImmersedGrains
     virtual ~MixtureFields() = default;
 
     virtual void
-    evaluate(const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
-             const std::vector<dealii::Point<dim>> &points,
-             double                                 time,
-             MixtureValues<dim>                    &values) const = 0;
+    evaluate(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>>                           &points,
+      double                                                           time,
+      MixtureValues<dim> &values) const = 0;
   };
 
 
@@ -67,10 +68,11 @@ namespace ImmersedGrains
       std::shared_ptr<dealii::Function<dim>> mass_source = nullptr);
 
     void
-    evaluate(const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
-             const std::vector<dealii::Point<dim>> &points,
-             double                                 time,
-             MixtureValues<dim>                    &values) const override;
+    evaluate(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>>                           &points,
+      double                                                           time,
+      MixtureValues<dim> &values) const override;
 
   private:
     std::shared_ptr<dealii::Function<dim>> fluid_fraction;

@@ -28,13 +28,13 @@ namespace ImmersedGrains
      */
     void
     write(const dealii::parallel::distributed::Triangulation<dim> &tria,
-          double                                                    time,
-          unsigned int                                              step,
-          const std::function<void(dealii::DataOut<dim> &)>        &add_fields);
+          double                                                   time,
+          unsigned int                                             step,
+          const std::function<void(dealii::DataOut<dim> &)>       &add_fields);
 
   private:
-    std::string                                directory;
-    MPI_Comm                                   comm;
+    std::string                                 directory;
+    MPI_Comm                                    comm;
     std::vector<std::pair<double, std::string>> records;
   };
 } // namespace ImmersedGrains

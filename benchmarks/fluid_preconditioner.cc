@@ -1,0 +1,189 @@
+// Robustness of the fluid solver's block preconditioner: outer FGMRES
+// iterations for one time step of the averaged Stokes-Brinkman system over
+// mesh levels, time steps (including steady), drag coefficients
+// (beta h^2/mu) and a fluid fraction that jumps between 0.35 and 1.
+//
+//   fluid_preconditioner DIM LEVEL_MIN LEVEL_MAX [advection] [schur]
+//
+// prints one markdown row per (level, dt, beta) with iterations, solve time
+// per DoF and peak memory. benchmarks/run_fluid_preconditioner.sh makes the
+// tables of doc/benchmarks.md.
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/utilities.h>
+#include <deal.II/distributed/tria.h>
+
+#include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/simulation.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+using namespace dealii;
+using namespace ImmersedGrains;
+
+// phi = 0.35 inside a ball of radius 0.3 around the centre of the unit box,
+// 1 outside, with a jump (no smoothing): the hard case for the Schur
+// approximation. beta follows phi (grains only where phi < 1).
+template <int dim>
+class JumpField : public Function<dim>
+{
+public:
+  JumpField(double inside, double outside)
+      : inside(inside)
+      , outside(outside)
+  {
+  }
+  double
+  value(const Point<dim> &x, unsigned int) const override
+  {
+    Point<dim> c;
+    for (unsigned int d = 0; d < dim; ++d)
+      c[d] = 0.5;
+    return x.distance(c) < 0.3 ? inside : outside;
+  }
+  Tensor<1, dim>
+  gradient(const Point<dim> &, unsigned int) const override
+  {
+    return Tensor<1, dim>();
+  }
+
+private:
+  double inside, outside;
+};
+
+// A swirling body force that makes flow through and around the porous ball.
+template <int dim>
+class Swirl : public Function<dim>
+{
+public:
+  Swirl()
+      : Function<dim>(dim)
+  {
+  }
+  double
+  value(const Point<dim> &x, unsigned int i) const override
+  {
+    const double s = std::sin(M_PI * x[0]) * std::sin(M_PI * x[1]);
+    if (i == 0)
+      return s * (x[1] - 0.5);
+    if (i == 1)
+      return -s * (x[0] - 0.5) + 1.0;
+    return 0.3 * s;
+  }
+};
+
+double
+peak_memory_mib()
+{
+  Utilities::System::MemoryStats stats;
+  Utilities::System::get_memory_stats(stats);
+  return stats.VmHWM / 1024.0;
+}
+
+template <int dim>
+void
+run(const unsigned int level_min,
+    const unsigned int level_max,
+    const bool         advection,
+    const std::string &schur,
+    const unsigned int cycles)
+{
+  const bool root = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
+  if (root)
+    std::printf(
+      "| dim | level | DoFs | dt | beta h^2/mu | iterations | solve s | "
+      "s per MDoF | peak MiB |\n|---|---|---|---|---|---|---|---|---|\n");
+  for (unsigned int level = level_min; level <= level_max; ++level)
+    for (const double dt : {1e-8, 1e-4, 1.0, 0.0})
+      for (const double beta_scaled : {0.0, 1.0, 1e4, 1e8})
+      {
+        ParameterHandler prm;
+        Simulation<dim>::declare_parameters(prm);
+        prm.parse_input_from_string(
+          std::string(
+            "subsection Fluid\n set Density = 1000\n set Viscosity = 1\n") +
+          " set Advection = " + (advection ? "true" : "false") +
+          "\n set Time derivative = " + (dt > 0 ? "true" : "false") +
+          "\n set Time scheme = BDF1\n subsection Linear solver\n"
+          "  set Tolerance = 1e-8\n  set Max iterations = 1000\n"
+          "  set Schur complement = " +
+          schur + "\n  set Velocity AMG cycles = " + std::to_string(cycles) +
+          "\n end\nend\n");
+        Geometry<dim> geometry;
+        geometry.parse_parameters(prm, "benchmark");
+        geometry.initial_refinement = level;
+        FluidParameters<dim> parameters;
+        parameters.parse_parameters(prm, "benchmark", geometry);
+
+        const double h      = 1.0 / (1 << level);
+        const double beta   = beta_scaled * parameters.viscosity / (h * h);
+        auto         fields = std::make_shared<PrescribedMixtureFields<dim>>(
+          std::make_shared<JumpField<dim>>(0.35, 1.0),
+          std::make_shared<JumpField<dim>>(beta, 0.0),
+          std::make_shared<Functions::ZeroFunction<dim>>(dim));
+
+        ConditionalOStream pcout(std::cout, false);
+        TimerOutput timer(pcout, TimerOutput::never, TimerOutput::wall_times);
+        parallel::distributed::Triangulation<dim> tria(MPI_COMM_WORLD);
+        geometry.create_mesh(tria);
+        FluidSolver<dim> fluid(parameters, geometry, tria, timer, pcout);
+        fluid.set_mixture_fields(fields);
+        fluid.set_forcing(std::make_shared<Swirl<dim>>());
+        fluid.setup_dofs();
+        fluid.set_initial_condition();
+        const auto start = std::chrono::steady_clock::now();
+        const auto stats =
+          fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0);
+        const double seconds = std::chrono::duration<double>(
+                                 std::chrono::steady_clock::now() - start)
+                                 .count();
+        const double memory =
+          Utilities::MPI::max(peak_memory_mib(), MPI_COMM_WORLD);
+        if (root)
+        {
+          char dt_text[32];
+          if (dt > 0)
+            std::snprintf(dt_text, sizeof(dt_text), "%g", dt);
+          else
+            std::snprintf(dt_text, sizeof(dt_text), "steady");
+          std::printf(
+            "| %d | %u | %llu | %s | %g | %u | %.2f | %.2f | %.0f |\n",
+            dim,
+            level,
+            static_cast<unsigned long long>(fluid.n_dofs()),
+            dt_text,
+            beta_scaled,
+            stats.linear_iterations,
+            seconds,
+            seconds / (fluid.n_dofs() * 1e-6),
+            memory);
+          std::fflush(stdout);
+        }
+      }
+}
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  if (argc < 4)
+  {
+    std::cerr << "usage: fluid_preconditioner DIM LEVEL_MIN LEVEL_MAX "
+                 "[stokes|advection] [Cahouet-Chabard|pressure mass|pressure "
+                 "Laplacian] "
+                 "[AMG cycles]\n";
+    return 1;
+  }
+  const int          dim      = std::atoi(argv[1]);
+  const unsigned int lmin     = std::atoi(argv[2]);
+  const unsigned int lmax     = std::atoi(argv[3]);
+  const bool        advection = argc > 4 && std::string(argv[4]) == "advection";
+  const std::string schur     = argc > 5 ? argv[5] : "Cahouet-Chabard";
+  const unsigned int cycles   = argc > 6 ? std::atoi(argv[6]) : 1;
+  if (dim == 2)
+    run<2>(lmin, lmax, advection, schur, cycles);
+  else
+    run<3>(lmin, lmax, advection, schur, cycles);
+}

@@ -1,0 +1,158 @@
+// Bad input must end with a non-zero exit status, exactly one line on stderr
+// that names the file and the parameter (and the value where there is one),
+// and no output directory. Each case below is a scene with one mistake.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+struct Case
+{
+  std::string name;
+  std::string body;      // the scene, without the output directory line
+  std::string parameter; // what the message must name
+  std::string value;     // and the offending value ("" if none)
+};
+
+int
+main()
+{
+  const std::string       good_mesh = R"(
+subsection Mesh
+  set Lower corner = 0, 0
+  set Upper corner = 1, 1
+  set Boundary conditions = wall, wall, wall, wall
+end
+)";
+  const std::vector<Case> cases     = {
+        {"unknown_parameter",
+         "set Dimension = 2\nset Viscosityy = 1\n",
+         "Viscosityy",
+         ""},
+        {"unknown_subsection",
+         "set Dimension = 2\nsubsection Fluidd\nend\n",
+         "Fluidd",
+         ""},
+        {"malformed_number",
+         "set Dimension = 2\nsubsection Fluid\n  set Viscosity = 1e-3x\nend\n",
+         "Viscosity",
+         "1e-3x"},
+        {"negative_viscosity",
+         "set Dimension = 2\nsubsection Fluid\n  set Viscosity = -1\nend\n",
+         "Viscosity",
+         "-1"},
+        {"zero_density",
+         "set Dimension = 2\nsubsection Fluid\n  set Density = 0\nend\n",
+         "Density",
+         "0"},
+        {"fluid_fraction_above_one",
+         "set Dimension = 2\nsubsection Fluid\n subsection Fluid fraction\n  set "
+             "Function expression = 1.2\n end\nend\n",
+         "Fluid fraction",
+         "1.2"},
+        {"fluid_fraction_zero",
+         "set Dimension = 2\nsubsection Fluid\n subsection Fluid fraction\n  set "
+             "Function expression = x - x\n end\nend\n",
+         "Fluid fraction",
+         "0"},
+        {"inverted_corners",
+         "set Dimension = 2\nsubsection Mesh\n  set Lower corner = 0, 1\n  set "
+             "Upper corner = 1, 0\nend\n",
+         "Upper corner",
+         "1, 0"},
+        {"wrong_corner_length",
+         "set Dimension = 3\nsubsection Mesh\n  set Lower corner = 0, 0\nend\n",
+         "Lower corner",
+         "0, 0"},
+        {"boundary_list_too_short",
+         "set Dimension = 2\nsubsection Mesh\n  set Boundary conditions = wall, "
+             "wall, wall\nend\n",
+         "Boundary conditions",
+         "wall, wall, wall"},
+        {"unknown_boundary_type",
+         "set Dimension = 2\nsubsection Mesh\n  set Boundary conditions = wall, "
+             "wall, wall, sticky\nend\n",
+         "Boundary conditions",
+         "sticky"},
+        {"unpaired_periodic",
+         "set Dimension = 2\nsubsection Mesh\n  set Boundary conditions = "
+             "periodic, wall, wall, wall\nend\n",
+         "Boundary conditions",
+         "periodic"},
+        {"bad_dimension", "set Dimension = 4\n", "Dimension", "4"},
+        {"negative_time_step",
+         "set Dimension = 2\nset Time step = -0.1\n",
+         "Time step",
+         "-0.1"},
+        {"bad_expression",
+         "set Dimension = 2\nsubsection Fluid\n subsection Forcing\n  set Function "
+             "expression = sin(; 0\n end\nend\n",
+         "Forcing",
+         ""},
+        {"bad_selection",
+         "set Dimension = 2\nsubsection Fluid\n  set Time scheme = BDF7\nend\n",
+         "Time scheme",
+         "BDF7"},
+        {"unknown_test_column",
+         "set Dimension = 2\nsubsection Output\n  set Test columns = step, "
+             "nonsense\nend\n",
+         "Test columns",
+         "nonsense"},
+  };
+
+  unsigned int failures = 0;
+  for (const Case &c : cases)
+  {
+    const std::string prm    = c.name + ".prm";
+    const std::string outdir = "out_" + c.name;
+    fs::remove_all(outdir);
+    {
+      std::ofstream f(prm);
+      f << c.body << "set Output directory = " << outdir << "\n";
+      (void)good_mesh;
+    }
+    const std::string command = std::string(IMMERSED_GRAINS_EXECUTABLE) + " " +
+                                prm + " > stdout_" + c.name + " 2> stderr_" +
+                                c.name;
+    const int status = std::system(command.c_str());
+
+    std::ifstream            err("stderr_" + c.name);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(err, line);)
+      lines.push_back(line);
+    const std::string message = lines.empty() ? "" : lines[0];
+
+    std::vector<std::string> problems;
+    if (status == 0)
+      problems.push_back("exit status 0");
+    if (lines.size() != 1)
+      problems.push_back(std::to_string(lines.size()) + " lines on stderr");
+    if (message.find(prm) == std::string::npos)
+      problems.push_back("file not named");
+    if (message.find(c.parameter) == std::string::npos)
+      problems.push_back("parameter not named");
+    if (!c.value.empty() && message.find(c.value) == std::string::npos)
+      problems.push_back("value not named");
+    if (fs::exists(outdir))
+      problems.push_back("output directory written");
+
+    std::cout << c.name << ": " << (problems.empty() ? "OK" : "FAILED");
+    for (const auto &p : problems)
+      std::cout << " [" << p << "]";
+    std::cout << std::endl;
+    if (!problems.empty())
+    {
+      std::cout << "    stderr: " << message << std::endl;
+      ++failures;
+    }
+  }
+  std::cout << failures << " of " << cases.size() << " cases failed"
+            << std::endl;
+  return failures == 0 ? 0 : 1;
+}
