@@ -2,7 +2,9 @@
 #include <deal.II/base/utilities.h>
 
 #include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/grains/grains.h>
 #include <immersed_grains/io/field_output.h>
+#include <immersed_grains/io/particle_output.h>
 #include <immersed_grains/simulation.h>
 
 #include <chrono>
@@ -44,7 +46,13 @@ namespace ImmersedGrains
                                "wall_time",
                                "fluid_nonlinear_iterations",
                                "fluid_residual",
-                               "fluid_volume"})
+                               "fluid_volume",
+                               "packing_fraction",
+                               "grains_removed",
+                               "contact_residual",
+                               "contact_converged",
+                               "max_contact_force",
+                               "alert_distance"})
         c.emplace_back(name);
       return c;
     }
@@ -67,7 +75,16 @@ namespace ImmersedGrains
                       "Where statistics.csv, log.txt and fields go; empty: "
                       "output/<parameter file name without .prm>.");
     prm.declare_entry("End time", "1", Double(0), "Simulated time [s].");
-    prm.declare_entry("Time step", "0.01", Double(0), "Time step [s].");
+    prm.declare_entry("Time step",
+                      "0.01",
+                      Double(0),
+                      "Time step [s]; with Adaptive time step, the largest.");
+    prm.declare_entry("Adaptive time step",
+                      "false",
+                      Bool(),
+                      "Shorten the step so that no grain moves more than "
+                      "Grains/Max displacement fraction of the smallest "
+                      "radius in one step.");
 
     prm.enter_subsection("Output");
     {
@@ -86,11 +103,24 @@ namespace ImmersedGrains
                         "step, time, solid_volume",
                         Anything(),
                         "Statistics columns printed per step in test mode.");
+      prm.declare_entry("Test every steps",
+                        "1",
+                        Integer(1),
+                        "Test mode prints every this many steps (and the "
+                        "last).");
+      prm.declare_entry("Test checks",
+                        "",
+                        Anything(),
+                        "Conditions on statistics columns at the end of the "
+                        "run, printed as yes/no in test mode, separated by "
+                        "';': 'column < v', 'column > v', 'column in [a, "
+                        "b]'.");
     }
     prm.leave_subsection();
 
     Geometry<dim>::declare_parameters(prm);
     FluidParameters<dim>::declare_parameters(prm);
+    GrainParameters<dim>::declare_parameters(prm);
   }
 
 
@@ -119,6 +149,7 @@ namespace ImmersedGrains
                 "Time step",
                 prm.get("Time step"),
                 "must be positive");
+    adaptive_time_step = prm.get_bool("Adaptive time step");
 
     prm.enter_subsection("Output");
     {
@@ -134,11 +165,19 @@ namespace ImmersedGrains
                       "Test columns",
                       prm.get("Test columns"),
                       "no statistics column named '" + c + "'");
+      test_every  = prm.get_integer("Test every steps");
+      test_checks = parse_test_checks(prm.get("Test checks"),
+                                      statistics,
+                                      where,
+                                      "Test checks");
     }
     prm.leave_subsection();
 
     geometry.parse_parameters(prm, file);
     fluid_parameters.parse_parameters(prm, file, geometry);
+    grain_parameters.parse_parameters(prm, file);
+    if (grain_parameters.enabled)
+      grain_seeds = place_grains(grain_parameters, geometry);
   }
 
 
@@ -169,6 +208,8 @@ namespace ImmersedGrains
     log.open(output_directory + "/log.txt", root, !quiet);
     statistics.open(output_directory + "/statistics.csv", root);
     field_output = std::make_unique<FieldOutput<dim>>(output_directory, comm);
+    particle_output =
+      std::make_unique<ParticleOutput<dim>>(output_directory, comm);
   }
 
 
@@ -205,6 +246,26 @@ namespace ImmersedGrains
                                                  "FGMRES + block AMG")
             << '\n';
     }
+
+    if (grain_parameters.enabled)
+    {
+      grains = std::make_unique<Grains<dim>>(grain_parameters,
+                                             geometry,
+                                             triangulation,
+                                             fluid_parameters.enabled,
+                                             *timer);
+      grains->initialize(grain_seeds);
+      const auto &c = grain_parameters.contact;
+      pcout << "  grains: " << grain_seeds.size() << ", "
+            << grains->layout().n_properties << " properties per grain";
+      if (grain_parameters.contacts_enabled)
+        pcout << "; contacts: e = " << c.restitution << ", mu = " << c.friction
+              << ", tolerance " << c.tolerance;
+      else
+        pcout << "; contacts off";
+      pcout << '\n';
+      grain_seeds.clear();
+    }
   }
 
 
@@ -224,15 +285,29 @@ namespace ImmersedGrains
     // Steps end exactly on End time; a last short step is allowed.
     while (time < end_time * (1 - 1e-12))
     {
-      const double dt = std::min(time_step, end_time - time);
+      const double dt = next_time_step();
       ++step;
       solve_time_step(dt);
       maybe_write_fields(time >= end_time * (1 - 1e-12));
     }
+    print_test_row(true);
+    if (test_output && dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      print_test_checks(std::cout, test_checks, statistics);
 
     pcout << "  done: " << step << " steps, wall time " << now() - wall_start
           << " s\n";
     timer->print_wall_time_statistics(comm);
+  }
+
+
+  template <int dim>
+  double
+  Simulation<dim>::next_time_step() const
+  {
+    double dt = time_step;
+    if (adaptive_time_step && grains)
+      dt = grains->stable_time_step(dt);
+    return std::min(dt, end_time - time);
   }
 
 
@@ -248,6 +323,22 @@ namespace ImmersedGrains
       fluid_iterations = stats.linear_iterations;
       statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
       statistics.set("fluid_residual", stats.final_residual);
+    }
+    if (grains)
+    {
+      const GrainStepReport report = grains->advance(dt);
+      const auto           &c      = report.contacts;
+      statistics.set("max_overlap", c.max_overlap);
+      statistics.set("contacts", c.n_active);
+      statistics.set("contact_iterations", c.iterations);
+      statistics.set("contact_residual", c.residual);
+      statistics.set("contact_converged", c.converged);
+      statistics.set("max_contact_force", report.max_contact_force);
+      statistics.set("alert_distance", report.alert_distance);
+      if (!c.converged && grain_parameters.contacts_enabled)
+        pcout << "  warning: step " << step << ": the contact solver stopped "
+              << "after " << c.iterations << " sweeps, residual "
+              << c.residual << ", overlap " << c.max_overlap << " m\n";
     }
     time = new_time;
     postprocess(dt, fluid_iterations);
@@ -275,14 +366,59 @@ namespace ImmersedGrains
       statistics.set("fluid_volume", fluid_volume);
       statistics.set("solid_volume", volume - fluid_volume);
     }
+    if (grains)
+      set_grain_statistics();
     statistics.set("wall_time", now() - wall_start);
     statistics.write_row();
 
-    if (test_output && dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-      statistics.print(std::cout, test_columns);
+    print_test_row(false);
     if (!quiet)
-      pcout << "step " << step << " t=" << time << " dt=" << dt
-            << " fluid iterations=" << fluid_iterations << '\n';
+    {
+      pcout << "step " << step << " t=" << time << " dt=" << dt;
+      if (fluid)
+        pcout << " fluid iterations=" << fluid_iterations;
+      if (grains)
+        pcout << " grains=" << statistics.get("particles")
+              << " contacts=" << statistics.get("contacts")
+              << " sweeps=" << statistics.get("contact_iterations")
+              << " Ekin=" << statistics.get("kinetic_energy");
+      pcout << '\n';
+    }
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::set_grain_statistics()
+  {
+    const GrainStatistics<dim> s = grains->compute_statistics();
+    const char                *axes[] = {"x", "y", "z"};
+    statistics.set("particles", s.n_grains);
+    if (!fluid)
+      statistics.set("solid_volume", s.solid_volume);
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      statistics.set(std::string("centroid_") + axes[d], s.centroid[d]);
+      statistics.set(std::string("mean_velocity_") + axes[d],
+                     s.mean_velocity[d]);
+    }
+    statistics.set("max_speed", s.max_speed);
+    statistics.set("kinetic_energy", s.kinetic_energy);
+    statistics.set("packing_fraction", s.packing_fraction);
+    statistics.set("grains_removed", grains->n_removed());
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::print_test_row(const bool last) const
+  {
+    if (!test_output || dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    // Rows every Test every steps, the last one always (once).
+    const bool regular = step % test_every == 0;
+    if (last ? !regular : regular)
+      statistics.print(std::cout, test_columns);
   }
 
 
@@ -290,16 +426,21 @@ namespace ImmersedGrains
   void
   Simulation<dim>::maybe_write_fields(const bool force)
   {
-    if (!fluid)
-      return;
     if (!force && (write_fields_every == 0 || step % write_fields_every != 0))
       return;
     dealii::TimerOutput::Scope scope(*timer, "output");
-    field_output->write(triangulation,
-                        time,
-                        step,
-                        [this](dealii::DataOut<dim> &d)
-                        { fluid->add_data_vectors(d); });
+    if (fluid)
+      field_output->write(triangulation,
+                          time,
+                          step,
+                          [this](dealii::DataOut<dim> &d)
+                          { fluid->add_data_vectors(d); });
+    if (grains)
+      particle_output->write(grains->particle_handler(),
+                             grains->layout().names,
+                             grains->layout().interpretations,
+                             time,
+                             step);
   }
 
 

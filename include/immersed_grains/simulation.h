@@ -7,8 +7,11 @@
 #include <deal.II/distributed/tria.h>
 
 #include <immersed_grains/fluid/fluid_parameters.h>
+#include <immersed_grains/grains/grain_parameters.h>
+#include <immersed_grains/grains/placement.h>
 #include <immersed_grains/io/run_log.h>
 #include <immersed_grains/io/statistics.h>
+#include <immersed_grains/io/test_checks.h>
 #include <immersed_grains/mesh/geometry.h>
 
 #include <memory>
@@ -20,6 +23,10 @@ namespace ImmersedGrains
   class FluidSolver;
   template <int dim>
   class FieldOutput;
+  template <int dim>
+  class Grains;
+  template <int dim>
+  class ParticleOutput;
 
   /**
    * One run of a scene: owns the mesh, the fluid solver, the grains and the
@@ -47,26 +54,38 @@ namespace ImmersedGrains
     prepare_output_directory();
     void
     setup();
+    double
+    next_time_step() const;
     void
     solve_time_step(double dt);
     void
     postprocess(double dt, unsigned int fluid_iterations);
     void
+    set_grain_statistics();
+    void
     maybe_write_fields(bool force);
+    void
+    print_test_row(bool last) const;
 
     MPI_Comm    comm;
     std::string parameter_file;
     std::string output_directory;
     double      end_time  = 1;
     double      time_step = 1;
+    bool        adaptive_time_step = false;
 
     unsigned int             write_fields_every = 0;
     bool                     test_output        = false;
     bool                     quiet              = false;
     std::vector<std::string> test_columns;
+    unsigned int             test_every = 1;
+    std::vector<TestCheck>   test_checks;
 
     Geometry<dim>        geometry;
     FluidParameters<dim> fluid_parameters;
+    GrainParameters<dim> grain_parameters;
+    // Placed while parsing, so that bad placements fail before any output.
+    std::vector<GrainSeed<dim>> grain_seeds;
 
     RunLog                               log;
     dealii::ConditionalOStream           pcout;
@@ -76,6 +95,8 @@ namespace ImmersedGrains
     dealii::parallel::distributed::Triangulation<dim> triangulation;
     std::unique_ptr<FluidSolver<dim>>                 fluid;
     std::unique_ptr<FieldOutput<dim>>                 field_output;
+    std::unique_ptr<Grains<dim>>                      grains;
+    std::unique_ptr<ParticleOutput<dim>>              particle_output;
 
     double       time = 0;
     unsigned int step = 0;

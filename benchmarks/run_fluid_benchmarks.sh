@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Fluid solver benchmarks for doc/benchmarks.md:
+#  1. preconditioner robustness: outer FGMRES iterations over mesh levels,
+#     time steps, drag and a jumping fluid fraction (2D levels 3..7, 3D 2..4;
+#     LARGE=1 adds 3D level 5);
+#  2. what switching physics off saves: the same scene solved as
+#     Navier-Stokes/BDF2, Stokes/BDF2 and steady Stokes.
+# Usage: benchmarks/run_fluid_benchmarks.sh [OUTDIR]  (after scripts/setup.sh)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source scripts/environment.sh
+out=${1:-benchmarks/results}
+mkdir -p "$out"
+cmake --build build --target benchmarks -j"$(nproc)" >/dev/null
+
+bin=build/benchmarks/fluid_preconditioner
+$bin 2 3 7 > "$out/preconditioner_2d.md"
+$bin 3 2 4 > "$out/preconditioner_3d.md"
+if [ "${LARGE:-0}" = 1 ]; then
+  $bin 3 5 5 > "$out/preconditioner_3d_level5.md"
+fi
+
+# Physics switched off: the porous channel scene, 10 steps each.
+{
+  echo "| model | steps | fluid iterations (sum) | wall time s |"
+  echo "|---|---|---|---|"
+  for model in "Navier-Stokes BDF2:true:true" "Stokes BDF2:false:true" "steady Stokes:false:false"; do
+    IFS=: read -r name advection transient <<<"$model"
+    scene="$out/channel_${advection}_${transient}.prm"
+    sed -e "s/set Advection = true/set Advection = $advection/" \
+        -e "/set Advection/a\\  set Time derivative = $transient" \
+        -e "s#^set Dimension = 2#set Dimension = 2\nset Output directory = $out/channel_${advection}_${transient}#" \
+        prm/porous_channel.prm > "$scene"
+    build/immersed-grains "$scene" >/dev/null
+    stats="$out/channel_${advection}_${transient}/statistics.csv"
+    python3 - "$name" "$stats" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[2])))
+its = sum(int(float(r["fluid_iterations"])) for r in rows)
+print(f"| {sys.argv[1]} | {len(rows) - 1} | {its} | {float(rows[-1]['wall_time']):.2f} |")
+PY
+  done
+} > "$out/physics_switch.md"
+cat "$out"/*.md

@@ -1,0 +1,127 @@
+#ifndef immersed_grains_grains_distributed_contacts_h
+#define immersed_grains_grains_distributed_contacts_h
+
+#include <deal.II/base/bounding_box.h>
+#include <deal.II/base/mpi.h>
+
+#include <immersed_grains/contact/bucket_grid.h>
+#include <immersed_grains/contact/contact_solver.h>
+#include <immersed_grains/contact/walls.h>
+#include <immersed_grains/mesh/geometry.h>
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /** The normal force of one contact of the last step. */
+  struct ContactForce
+  {
+    std::uint64_t grain;   // id of the first grain
+    std::uint64_t partner; // id of the second grain, or the wall number
+    bool          wall;    // partner is a wall
+    double        force;   // normal impulse / dt [N] (2D: per unit depth)
+  };
+
+  /**
+   * One contact step (neighbour search, walls, non-smooth contact solver)
+   * for the grains a rank owns, with the exchange that makes the converged
+   * answer independent of the number of ranks (doc/contacts.md, section
+   * "Distributed memory"):
+   *
+   *  - ghosts: each rank receives copies of the grains owned elsewhere that
+   *    lie within reach (largest radius plus alert distance) of its own
+   *    cells' bounding boxes;
+   *  - each contact is solved by exactly one rank, the lowest rank owning
+   *    one of its grains;
+   *  - a grain with copies on k ranks enters every copy's Delassus operator
+   *    with the mass m/k (mass splitting, Visseq et al. 2012); after each
+   *    Gauss-Seidel sweep the copies are glued by averaging their
+   *    velocities, which gives exactly v + sum(impulses)/m: at convergence
+   *    every contact law and the true equation of motion hold, as in serial;
+   *  - convergence is decided on the maxima over all ranks, so all ranks
+   *    sweep the same number of times.
+   * On one rank this is the serial solver without any copying.
+   */
+  template <int dim>
+  class DistributedContacts
+  {
+  public:
+    DistributedContacts(const Geometry<dim>               &geometry,
+                        const Contact::ContactParameters &parameters,
+                        MPI_Comm                          comm);
+
+    /**
+     * The bounding boxes of each rank's locally owned cells (all_gather of
+     * GridTools::compute_mesh_predicate_bounding_box); needed again after
+     * the mesh or its partition changes.
+     */
+    void
+    set_partition(
+      const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes);
+
+    /**
+     * Resolves the contacts of the owned grains at @p positions: grains go
+     * in with free velocities and come out with end-of-step velocities.
+     * The result holds global numbers (sums or maxima over ranks).
+     */
+    Contact::SolverResult
+    solve(const std::vector<dealii::Point<dim>> &positions,
+          Contact::GrainArrays<dim>             &grains,
+          double                                 time_step,
+          double                                 alert_distance);
+
+    /** Largest normal contact force of the last step, over all ranks. */
+    double
+    max_contact_force() const;
+
+    /** The contacts this rank solved in the last step, with their forces. */
+    std::vector<ContactForce>
+    contact_forces() const;
+
+  private:
+    MPI_Comm           comm;
+    const unsigned int my_rank;
+    const unsigned int n_ranks;
+    const bool         friction;
+    const Geometry<dim> &geometry;
+
+    Contact::BucketGrid<dim>    grid;
+    Contact::Walls<dim>         walls;
+    Contact::ContactSolver<dim> solver;
+
+    std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
+
+    // This step's work: owned grains then ghosts.
+    unsigned int                           n_owned = 0;
+    double                                 time_step = 0;
+    std::vector<dealii::Point<dim>>        all_positions;
+    std::vector<unsigned int>              ghost_owner;
+    std::map<unsigned int, std::vector<unsigned int>> send_lists; // owned
+    std::map<unsigned int, std::vector<unsigned int>> recv_lists; // ghosts
+    std::vector<unsigned int>              multiplicity;          // owned
+    std::vector<Contact::GrainPair<dim>>   pairs;
+    std::vector<Contact::WallContact<dim>> wall_contacts;
+    std::vector<std::uint64_t>             ids;
+    std::vector<double>                    send_buffer, recv_buffer;
+
+    double
+    distance_to_rank(const dealii::Point<dim> &x, unsigned int rank) const;
+
+    void
+    exchange_ghosts(Contact::GrainArrays<dim> &grains, double reach);
+
+    void
+    drop_ghosts(Contact::GrainArrays<dim> &grains) const;
+
+    void
+    keep_own_contacts();
+
+    /** Averages the velocities of every grain's copies (mass splitting). */
+    void
+    glue_copies();
+  };
+} // namespace ImmersedGrains
+
+#endif

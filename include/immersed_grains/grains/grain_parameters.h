@@ -1,0 +1,104 @@
+#ifndef immersed_grains_grains_grain_parameters_h
+#define immersed_grains_grains_grain_parameters_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <immersed_grains/contact/contact_solver.h>
+#include <immersed_grains/parameters.h>
+
+#include <string>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /** How the radii of randomly placed grains are drawn. */
+  enum class RadiusDistribution
+  {
+    constant, // every grain has Radius
+    uniform,  // uniform in [Minimum radius, Maximum radius]
+    normal    // normal(Radius, Radius deviation), redrawn outside the bounds
+  };
+
+  /** Where the initial grains come from (`subsection Placement`). */
+  enum class PlacementShape
+  {
+    ball,    // random non-overlapping fill of a ball (disc in 2D)
+    box,     // random non-overlapping fill of a box
+    list,    // Positions (and Velocities) in the .prm
+    file,    // a text/CSV file: x, y[, z][, r[, vx, vy[, vz]]] per line
+    lattice, // square/cubic lattice of spacing 2 r_max filling the box
+  };
+
+  /**
+   * Everything in `subsection Grains`, `subsection Contacts` and
+   * `subsection Gravity`. Values are in SI units; the text of each entry is
+   * kept where a later check (placement) must name it in an InputError.
+   */
+  template <int dim>
+  struct GrainParameters
+  {
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    void
+    parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
+
+    std::string file; // the parameter file, for messages
+
+    // Grains
+    bool                enabled = false;
+    double              radius  = 1e-3;
+    std::vector<double> radii; // one per grain, or empty
+    std::string         radii_text;
+    RadiusDistribution  radius_distribution = RadiusDistribution::constant;
+    double              min_radius          = 1e-3;
+    double              max_radius          = 1e-3;
+    double              radius_deviation    = 0;
+    double              density             = 2500;
+    bool                fixed               = false;
+    double              max_displacement    = 0.125; // of the smallest radius
+
+    // Grains/Placement
+    PlacementShape                  shape = PlacementShape::list;
+    dealii::Point<dim>              center;
+    std::vector<double>             size; // ball: 1 value; box: dim values
+    double                          solid_fraction = 0.3;
+    unsigned int                    count          = 0;
+    std::vector<dealii::Point<dim>> positions;
+    std::vector<dealii::Point<dim>> velocities; // as points: one per grain
+    unsigned int                    random_seed = 1;
+    std::string                     placement_file;
+    // The entry texts, for messages naming them.
+    std::string size_text, solid_fraction_text, count_text, positions_text,
+      velocities_text;
+
+    // Contacts
+    bool                       contacts_enabled = true;
+    Contact::ContactParameters contact;
+    double                     alert_distance  = 0; // [m]; 0: automatic
+    bool                       stop_on_failure = false;
+
+    // Gravity
+    dealii::Tensor<1, dim> gravity;
+  };
+
+  /** Volume of a grain of radius r: pi r^2 (disc per unit depth) in 2D. */
+  template <int dim>
+  inline double
+  grain_volume(const double r)
+  {
+    return dim == 2 ? M_PI * r * r : 4. / 3. * M_PI * r * r * r;
+  }
+
+  /** Moment of inertia per unit mass, I / m: r^2/2 disc, 2 r^2/5 sphere. */
+  template <int dim>
+  inline double
+  inertia_per_mass(const double r)
+  {
+    return (dim == 2 ? 0.5 : 0.4) * r * r;
+  }
+} // namespace ImmersedGrains
+
+#endif

@@ -1,0 +1,186 @@
+#ifndef immersed_grains_grains_grains_h
+#define immersed_grains_grains_grains_h
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/numerics/data_component_interpretation.h>
+#include <deal.II/particles/particle_handler.h>
+
+#include <immersed_grains/contact/contact_solver.h>
+#include <immersed_grains/grains/distributed_contacts.h>
+#include <immersed_grains/grains/grain_parameters.h>
+#include <immersed_grains/grains/placement.h>
+#include <immersed_grains/mesh/geometry.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /**
+   * Where each quantity sits among a particle's properties. Only what the
+   * scene needs is stored: velocity and radius always (the mass follows
+   * from the one density), the angular velocity only with friction, the
+   * fluid force only with a fluid.
+   */
+  struct GrainPropertyLayout
+  {
+    static constexpr unsigned int absent = dealii::numbers::invalid_unsigned_int;
+
+    unsigned int velocity         = 0;
+    unsigned int radius           = absent;
+    unsigned int angular_velocity = absent;
+    unsigned int fluid_force      = absent;
+    unsigned int n_properties     = 0;
+
+    /** Names and interpretations per component, for particle output. */
+    std::vector<std::string> names;
+    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+      interpretations;
+  };
+
+  /**
+   * The arrays of one step, gathered once from the ParticleHandler in its
+   * iteration order (owned grains of this rank). The coupling hooks are
+   * empty unless a caller fills them between Grains::gather() and
+   * Grains::compute_free_velocities(); empty means "off" and costs nothing.
+   */
+  template <int dim>
+  struct GrainStepArrays
+  {
+    std::vector<dealii::Point<dim>> position;
+    std::vector<double>             mass;
+
+    /** velocity: current on gather, free after compute_free_velocities(),
+     *  end-of-step after resolve_contacts(). */
+    Contact::GrainArrays<dim> contact;
+
+    /** Hook: a force per grain other than gravity [N] (e.g. the fluid's). */
+    std::vector<dealii::Tensor<1, dim>> external_force;
+    /** Hook: implicit drag beta_i = dD_i/dw [kg/s]; the effective mass is
+     *  m_i + dt beta_i (in the contact solver too). */
+    std::vector<double> drag_coefficient;
+    /** Hook: the velocity the drag pulls towards (fluid velocity at the
+     *  grain), with drag_coefficient. */
+    std::vector<dealii::Tensor<1, dim>> drag_velocity;
+  };
+
+  /** Global measures of the grain population (sums/means over ranks). */
+  template <int dim>
+  struct GrainStatistics
+  {
+    double                 n_grains       = 0;
+    double                 solid_volume   = 0;
+    dealii::Point<dim>     centroid;
+    dealii::Tensor<1, dim> mean_velocity;
+    double                 max_speed        = 0;
+    double                 kinetic_energy   = 0;
+    double                 packing_fraction = 0;
+  };
+
+  /** What one grain step did (global numbers). */
+  struct GrainStepReport
+  {
+    Contact::SolverResult contacts;
+    double                max_contact_force = 0;
+    double                alert_distance    = 0;
+    unsigned long         removed           = 0; // this step, open faces
+  };
+
+  /**
+   * The grain population on a Particles::ParticleHandler and its dry
+   * dynamics: gravity, external forces and (hooks for) implicit drag, then
+   * non-smooth contacts, then the position update. A step is
+   *
+   *   gather() -> [coupling fills hooks] -> compute_free_velocities(dt)
+   *   -> resolve_contacts(dt) -> move_and_scatter(dt)
+   *
+   * and advance(dt) runs all of it. Grains leaving through open faces are
+   * removed and counted; periodic faces wrap.
+   */
+  template <int dim>
+  class Grains
+  {
+  public:
+    Grains(const GrainParameters<dim>                              &parameters,
+           const Geometry<dim>                                     &geometry,
+           const dealii::parallel::distributed::Triangulation<dim> &tria,
+           bool                                                     with_fluid,
+           dealii::TimerOutput                                     &timer);
+
+    /** Inserts the initial grains (the same list on every rank); grain k
+     *  gets particle id k. */
+    void
+    initialize(const std::vector<GrainSeed<dim>> &seeds);
+
+    /** Recomputes the ranks' bounding boxes after the mesh changed. */
+    void
+    update_partition();
+
+    /** Largest step <= max_step in which no grain moves more than the Max
+     *  displacement fraction of the smallest radius (collective). */
+    double
+    stable_time_step(double max_step) const;
+
+    GrainStepReport
+    advance(double dt);
+
+    void
+    gather();
+
+    void
+    compute_free_velocities(double dt);
+
+    GrainStepReport
+    resolve_contacts(double dt);
+
+    /** x += dt v, removes/wraps, writes back and sorts into cells. Returns
+     *  the number of grains removed on all ranks. */
+    unsigned long
+    move_and_scatter(double dt);
+
+    GrainStepArrays<dim> &
+    step_arrays();
+
+    GrainStatistics<dim>
+    compute_statistics() const;
+
+    const dealii::Particles::ParticleHandler<dim> &
+    particle_handler() const;
+
+    const GrainPropertyLayout &
+    layout() const;
+
+    /** Contacts solved on this rank in the last step. */
+    std::vector<ContactForce>
+    contact_forces() const;
+
+    unsigned long
+    n_removed() const;
+
+    double
+    mass(double radius) const;
+
+  private:
+    const GrainParameters<dim>                              &parameters;
+    const Geometry<dim>                                     &geometry;
+    const dealii::parallel::distributed::Triangulation<dim> &triangulation;
+    MPI_Comm                                                 comm;
+    dealii::TimerOutput                                     &timer;
+
+    dealii::MappingQ1<dim>                  mapping;
+    GrainPropertyLayout                     properties;
+    dealii::Particles::ParticleHandler<dim> particles;
+    std::unique_ptr<DistributedContacts<dim>> contacts;
+    std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
+
+    GrainStepArrays<dim> arrays;
+    unsigned long        removed_total = 0;
+    unsigned long        lost          = 0;
+  };
+} // namespace ImmersedGrains
+
+#endif

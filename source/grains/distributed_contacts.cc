@@ -1,0 +1,482 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <immersed_grains/grains/distributed_contacts.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    constexpr int glue_to_owner_tag   = 7411;
+    constexpr int glue_from_owner_tag = 7412;
+
+    template <int dim>
+    std::array<bool, dim>
+    periodic_axes(const Geometry<dim> &geometry)
+    {
+      std::array<bool, dim> p;
+      for (unsigned int d = 0; d < dim; ++d)
+        p[d] = geometry.is_periodic(d);
+      return p;
+    }
+
+    template <int dim>
+    std::array<bool, 2 * dim>
+    wall_faces(const Geometry<dim> &geometry)
+    {
+      // Open faces let grains leave, periodic ones wrap them: no walls.
+      std::array<bool, 2 * dim> w;
+      for (unsigned int f = 0; f < 2 * dim; ++f)
+        w[f] = geometry.boundary_types[f] != BoundaryType::open &&
+               geometry.boundary_types[f] != BoundaryType::periodic;
+      return w;
+    }
+  } // namespace
+
+
+  template <int dim>
+  DistributedContacts<dim>::DistributedContacts(
+    const Geometry<dim>               &geometry,
+    const Contact::ContactParameters &parameters,
+    MPI_Comm                          comm)
+      : comm(comm)
+      , my_rank(dealii::Utilities::MPI::this_mpi_process(comm))
+      , n_ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
+      , friction(parameters.friction > 0)
+      , geometry(geometry)
+      , grid(geometry.lower_corner,
+             geometry.upper_corner,
+             periodic_axes(geometry))
+      , solver(parameters)
+  {
+    walls.add_box(geometry.lower_corner,
+                  geometry.upper_corner,
+                  wall_faces(geometry));
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::set_partition(
+    const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes)
+  {
+    rank_boxes = boxes;
+  }
+
+
+  template <int dim>
+  double
+  DistributedContacts<dim>::distance_to_rank(const dealii::Point<dim> &x,
+                                             const unsigned int rank) const
+  {
+    // Per axis the distance to the box's interval, on a periodic axis to
+    // the nearest image of it.
+    double best = std::numeric_limits<double>::max();
+    for (const auto &box : rank_boxes[rank])
+    {
+      double d2 = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double lo = box.get_boundary_points().first[d];
+        const double hi = box.get_boundary_points().second[d];
+        const auto   gap = [&](const double y)
+        { return std::max({lo - y, y - hi, 0.}); };
+        double g = gap(x[d]);
+        if (geometry.is_periodic(d))
+        {
+          const double L =
+            geometry.upper_corner[d] - geometry.lower_corner[d];
+          g = std::min({g, gap(x[d] - L), gap(x[d] + L)});
+        }
+        d2 += g * g;
+      }
+      best = std::min(best, std::sqrt(d2));
+    }
+    return best;
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::exchange_ghosts(Contact::GrainArrays<dim> &g,
+                                            const double               reach)
+  {
+    constexpr unsigned int spin_dim = (dim == 2 ? 1 : 3);
+    const bool             start    = !g.start_velocity.empty();
+    const unsigned int     width =
+      2 + 2 * dim + (start ? dim : 0) + 1 + (friction ? 1 + spin_dim : 0) + 1;
+
+    send_lists.clear();
+    recv_lists.clear();
+    multiplicity.assign(n_owned, 1);
+    for (unsigned int i = 0; i < n_owned; ++i)
+      for (unsigned int q = 0; q < n_ranks; ++q)
+        if (q != my_rank &&
+            distance_to_rank(all_positions[i], q) < g.radius[i] + reach)
+        {
+          send_lists[q].push_back(i);
+          ++multiplicity[i];
+        }
+
+    std::map<unsigned int, std::vector<double>> out;
+    for (const auto &[q, list] : send_lists)
+    {
+      auto &buffer = out[q];
+      buffer.reserve(list.size() * width);
+      for (const unsigned int i : list)
+      {
+        buffer.push_back(static_cast<double>(ids[i]));
+        buffer.push_back(multiplicity[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+          buffer.push_back(all_positions[i][d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          buffer.push_back(g.velocity[i][d]);
+        if (start)
+          for (unsigned int d = 0; d < dim; ++d)
+            buffer.push_back(g.start_velocity[i][d]);
+        buffer.push_back(g.inverse_mass[i]);
+        if (friction)
+        {
+          buffer.push_back(g.inverse_inertia[i]);
+          for (unsigned int d = 0; d < spin_dim; ++d)
+            buffer.push_back(g.angular_velocity[i][d]);
+        }
+        buffer.push_back(g.radius[i]);
+      }
+    }
+    const auto in = dealii::Utilities::MPI::some_to_some(comm, out);
+
+    // Mass splitting: every copy of a shared grain carries m/k.
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (multiplicity[i] > 1)
+      {
+        g.inverse_mass[i] *= multiplicity[i];
+        if (friction)
+          g.inverse_inertia[i] *= multiplicity[i];
+      }
+
+    ghost_owner.clear();
+    for (const auto &[q, buffer] : in)
+    {
+      auto &list = recv_lists[q];
+      for (std::size_t p = 0; p < buffer.size(); p += width)
+      {
+        const double *b = buffer.data() + p;
+        list.push_back(all_positions.size());
+        ghost_owner.push_back(q);
+        ids.push_back(static_cast<std::uint64_t>(b[0]));
+        const double     k = b[1];
+        dealii::Point<dim> x;
+        dealii::Tensor<1, dim> v, v0;
+        unsigned int     c = 2;
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d] = b[c++];
+        for (unsigned int d = 0; d < dim; ++d)
+          v[d] = b[c++];
+        all_positions.push_back(x);
+        g.velocity.push_back(v);
+        if (start)
+        {
+          for (unsigned int d = 0; d < dim; ++d)
+            v0[d] = b[c++];
+          g.start_velocity.push_back(v0);
+        }
+        g.inverse_mass.push_back(k * b[c++]);
+        if (friction)
+        {
+          g.inverse_inertia.push_back(k * b[c++]);
+          Contact::AngularVelocity<dim> w;
+          for (unsigned int d = 0; d < spin_dim; ++d)
+            w[d] = b[c++];
+          g.angular_velocity.push_back(w);
+        }
+        g.radius.push_back(b[c++]);
+      }
+    }
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::keep_own_contacts()
+  {
+    // A contact belongs to the lowest rank owning one of its grains; the
+    // others see it only through the glued velocities.
+    const auto owner = [&](const unsigned int i)
+    { return i < n_owned ? my_rank : ghost_owner[i - n_owned]; };
+    pairs.erase(std::remove_if(pairs.begin(),
+                               pairs.end(),
+                               [&](const Contact::GrainPair<dim> &p)
+                               {
+                                 return std::min(owner(p.first),
+                                                 owner(p.second)) != my_rank;
+                               }),
+                pairs.end());
+    wall_contacts.erase(std::remove_if(wall_contacts.begin(),
+                                       wall_contacts.end(),
+                                       [&](const Contact::WallContact<dim> &c)
+                                       { return c.grain >= n_owned; }),
+                        wall_contacts.end());
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::glue_copies()
+  {
+    if (n_ranks == 1)
+      return;
+    constexpr unsigned int spin_dim = (dim == 2 ? 1 : 3);
+    const unsigned int     width    = dim + (friction ? spin_dim : 0);
+    const auto pack = [&](const unsigned int i, double *b)
+    {
+      const auto v = solver.get_velocity(i);
+      for (unsigned int d = 0; d < dim; ++d)
+        b[d] = v[d];
+      if (friction)
+      {
+        const auto w = solver.get_angular_velocity(i);
+        for (unsigned int d = 0; d < spin_dim; ++d)
+          b[dim + d] = w[d];
+      }
+    };
+    const auto unpack = [&](const unsigned int i, const double *b)
+    {
+      dealii::Tensor<1, dim> v;
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = b[d];
+      solver.set_velocity(i, v);
+      if (friction)
+      {
+        Contact::AngularVelocity<dim> w;
+        for (unsigned int d = 0; d < spin_dim; ++d)
+          w[d] = b[dim + d];
+        solver.set_angular_velocity(i, w);
+      }
+    };
+    const auto exchange = [&](const auto &outgoing,
+                              const auto &incoming,
+                              const int   tag,
+                              const auto &fill)
+    {
+      std::size_t n_out = 0, n_in = 0;
+      for (const auto &[q, list] : outgoing)
+        n_out += list.size() * width;
+      for (const auto &[q, list] : incoming)
+        n_in += list.size() * width;
+      send_buffer.resize(n_out);
+      recv_buffer.resize(n_in);
+      std::vector<MPI_Request> requests;
+      std::size_t              offset = 0;
+      for (const auto &[q, list] : incoming)
+      {
+        requests.emplace_back();
+        MPI_Irecv(recv_buffer.data() + offset,
+                  list.size() * width,
+                  MPI_DOUBLE,
+                  q,
+                  tag,
+                  comm,
+                  &requests.back());
+        offset += list.size() * width;
+      }
+      offset = 0;
+      for (const auto &[q, list] : outgoing)
+      {
+        for (std::size_t m = 0; m < list.size(); ++m)
+          fill(list[m], send_buffer.data() + offset + m * width);
+        requests.emplace_back();
+        MPI_Isend(send_buffer.data() + offset,
+                  list.size() * width,
+                  MPI_DOUBLE,
+                  q,
+                  tag,
+                  comm,
+                  &requests.back());
+        offset += list.size() * width;
+      }
+      MPI_Waitall(requests.size(), requests.data(), MPI_STATUSES_IGNORE);
+    };
+
+    // 1. Ghost copies go to their owners, which average all copies.
+    exchange(recv_lists, send_lists, glue_to_owner_tag, pack);
+    std::vector<double> sum(n_owned * width, 0.);
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (multiplicity[i] > 1)
+        pack(i, sum.data() + i * width);
+    std::size_t offset = 0;
+    for (const auto &[q, list] : send_lists)
+      for (const unsigned int i : list)
+      {
+        for (unsigned int c = 0; c < width; ++c)
+          sum[i * width + c] += recv_buffer[offset + c];
+        offset += width;
+      }
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (multiplicity[i] > 1)
+      {
+        for (unsigned int c = 0; c < width; ++c)
+          sum[i * width + c] /= multiplicity[i];
+        unpack(i, sum.data() + i * width);
+      }
+
+    // 2. The glued velocities go back to every copy.
+    exchange(send_lists,
+             recv_lists,
+             glue_from_owner_tag,
+             [&](const unsigned int i, double *b) { pack(i, b); });
+    offset = 0;
+    for (const auto &[q, list] : recv_lists)
+      for (const unsigned int i : list)
+      {
+        unpack(i, recv_buffer.data() + offset);
+        offset += width;
+      }
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::drop_ghosts(Contact::GrainArrays<dim> &g) const
+  {
+    const auto cut = [&](auto &v)
+    {
+      if (v.size() > n_owned)
+        v.resize(n_owned);
+    };
+    cut(g.velocity);
+    cut(g.angular_velocity);
+    cut(g.start_velocity);
+    cut(g.inverse_mass);
+    cut(g.inverse_inertia);
+    cut(g.radius);
+    cut(g.id);
+    for (unsigned int i = 0; i < n_owned; ++i)
+      if (multiplicity.size() == n_owned && multiplicity[i] > 1)
+      {
+        g.inverse_mass[i] /= multiplicity[i];
+        if (friction)
+          g.inverse_inertia[i] /= multiplicity[i];
+      }
+  }
+
+
+  template <int dim>
+  Contact::SolverResult
+  DistributedContacts<dim>::solve(const std::vector<dealii::Point<dim>> &x,
+                                  Contact::GrainArrays<dim> &g,
+                                  const double               dt,
+                                  const double               alert)
+  {
+    n_owned   = x.size();
+    time_step = dt;
+    all_positions.assign(x.begin(), x.end());
+    ids = g.id;
+    if (ids.empty())
+      for (unsigned int i = 0; i < n_owned; ++i)
+        ids.push_back(i);
+    multiplicity.assign(n_owned, 1);
+    ghost_owner.clear();
+    send_lists.clear();
+    recv_lists.clear();
+
+    double r_max = 0;
+    for (const double r : g.radius)
+      r_max = std::max(r_max, r);
+    r_max = dealii::Utilities::MPI::max(r_max, comm);
+    if (n_ranks > 1)
+    {
+      exchange_ghosts(g, r_max + alert);
+      g.id = ids;
+    }
+
+    grid.find_pairs(all_positions, g.radius, alert, pairs);
+    walls.find_contacts(all_positions, g.radius, alert, wall_contacts);
+    if (n_ranks > 1)
+      keep_own_contacts();
+
+    const auto &prm = solver.get_parameters();
+    Contact::SolverResult result;
+    solver.setup(pairs, wall_contacts, walls.velocities(), g, dt);
+    glue_copies();
+    bool   converged = false;
+    double overlap   = 0;
+    while (!converged && result.iterations < prm.max_iterations)
+    {
+      Contact::SweepResult s = solver.sweep();
+      ++result.iterations;
+      glue_copies();
+      if (n_ranks > 1)
+      {
+        double local[2] = {s.max_change, s.max_impulse}, global[2];
+        dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 2),
+                                    comm,
+                                    dealii::ArrayView<double>(global, 2));
+        s.max_change  = global[0];
+        s.max_impulse = global[1];
+      }
+      result.residual = s.max_impulse > 0 ? s.max_change / s.max_impulse : 0;
+      if (s.max_change <= prm.tolerance * s.max_impulse)
+      {
+        overlap = solver.predicted_max_overlap();
+        converged =
+          dealii::Utilities::MPI::min(int(solver.converged(s, overlap)), comm);
+      }
+    }
+    overlap = solver.predicted_max_overlap();
+    solver.finish(g);
+    drop_ghosts(g);
+
+    unsigned int active = 0;
+    for (const double p : solver.pair_impulses().normal)
+      active += (p > 0);
+    for (const double p : solver.wall_impulses().normal)
+      active += (p > 0);
+    result.converged   = converged;
+    result.max_overlap = dealii::Utilities::MPI::max(overlap, comm);
+    result.n_contacts  = dealii::Utilities::MPI::sum(
+      static_cast<unsigned int>(pairs.size() + wall_contacts.size()), comm);
+    result.n_active = dealii::Utilities::MPI::sum(active, comm);
+    return result;
+  }
+
+
+  template <int dim>
+  double
+  DistributedContacts<dim>::max_contact_force() const
+  {
+    double p = 0;
+    for (const double q : solver.pair_impulses().normal)
+      p = std::max(p, q);
+    for (const double q : solver.wall_impulses().normal)
+      p = std::max(p, q);
+    return dealii::Utilities::MPI::max(time_step > 0 ? p / time_step : 0.,
+                                       comm);
+  }
+
+
+  template <int dim>
+  std::vector<ContactForce>
+  DistributedContacts<dim>::contact_forces() const
+  {
+    std::vector<ContactForce> forces;
+    const auto               &pn = solver.pair_impulses().normal;
+    for (unsigned int m = 0; m < pairs.size() && m < pn.size(); ++m)
+      forces.push_back(
+        {ids[pairs[m].first], ids[pairs[m].second], false, pn[m] / time_step});
+    const auto &wn = solver.wall_impulses().normal;
+    for (unsigned int m = 0; m < wall_contacts.size() && m < wn.size(); ++m)
+      forces.push_back({ids[wall_contacts[m].grain],
+                        wall_contacts[m].wall,
+                        true,
+                        wn[m] / time_step});
+    return forces;
+  }
+
+
+  template class DistributedContacts<2>;
+  template class DistributedContacts<3>;
+} // namespace ImmersedGrains

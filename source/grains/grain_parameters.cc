@@ -1,0 +1,310 @@
+#include <immersed_grains/grains/grain_parameters.h>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  void
+  GrainParameters<dim>::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii::Patterns;
+    prm.enter_subsection("Grains");
+    {
+      prm.declare_entry("Enabled",
+                        "false",
+                        Bool(),
+                        "Simulate grains (rigid discs in 2D, spheres in 3D).");
+      prm.declare_entry("Radius", "1e-3", Double(0), "Grain radius r [m].");
+      prm.declare_entry("Radii",
+                        "",
+                        Anything(),
+                        "One radius per grain (comma list); overrides Radius "
+                        "and Radius distribution. With Shape = ball or box it "
+                        "also sets how many grains are placed.");
+      prm.declare_entry("Radius distribution",
+                        "constant",
+                        Selection("constant|uniform|normal"),
+                        "Polydisperse radii for Shape = ball, box or "
+                        "lattice: constant (Radius), uniform in [Minimum "
+                        "radius, Maximum radius], or normal with mean Radius "
+                        "and Radius deviation, redrawn outside the bounds.");
+      prm.declare_entry("Minimum radius", "0", Double(0), "[m], see above.");
+      prm.declare_entry("Maximum radius", "0", Double(0), "[m], see above.");
+      prm.declare_entry("Radius deviation",
+                        "0",
+                        Double(0),
+                        "Standard deviation of the normal distribution [m].");
+      prm.declare_entry("Density",
+                        "2500",
+                        Double(0),
+                        "Grain density rho_p [kg/m^3] (2D: mass per unit "
+                        "depth is rho_p pi r^2).");
+      prm.declare_entry("Fixed",
+                        "false",
+                        Bool(),
+                        "The grains do not move (a fixed bed): infinite mass "
+                        "for the contact solver.");
+      prm.declare_entry("Max displacement fraction",
+                        "0.125",
+                        Double(0),
+                        "With Adaptive time step, no grain moves more than "
+                        "this fraction of the smallest radius in one step.");
+
+      prm.enter_subsection("Placement");
+      {
+        prm.declare_entry("Shape",
+                          "list",
+                          Selection("ball|box|list|file|lattice"),
+                          "ball/box: random non-overlapping fill (random "
+                          "sequential addition); list: Positions; file: "
+                          "File; lattice: square (cubic) lattice of spacing "
+                          "2 r_max filling the box Center, Size.");
+        prm.declare_entry("Center",
+                          dim == 2 ? "0.5, 0.5" : "0.5, 0.5, 0.5",
+                          Anything(),
+                          "Centre of the ball or box (comma list) [m].");
+        prm.declare_entry("Size",
+                          "0.25",
+                          Anything(),
+                          "The ball's radius, or the box's edge lengths as a "
+                          "comma list (one value: a cube) [m].");
+        prm.declare_entry("Solid fraction",
+                          "0.3",
+                          Double(),
+                          "Volume fraction of the ball or box filled with "
+                          "grains when Count = 0.");
+        prm.declare_entry("Count",
+                          "0",
+                          Integer(0),
+                          "Number of grains for ball, box and lattice (0: "
+                          "from Solid fraction; lattice: fill the box).");
+        prm.declare_entry("Positions",
+                          "",
+                          Anything(),
+                          "Shape = list: centres, points separated by ';', "
+                          "coordinates by ',' (e.g. 0,0.1; 0,0.2).");
+        prm.declare_entry("Velocities",
+                          "",
+                          Anything(),
+                          "Initial velocities, same format: one per grain, "
+                          "or one for all, or empty (at rest).");
+        prm.declare_entry("Random seed", "1", Integer(0), "Seed of the fill.");
+        prm.declare_entry("File",
+                          "",
+                          Anything(),
+                          "Shape = file: one grain per line, 'x y [z] [r "
+                          "[vx vy [vz]]]' separated by spaces or commas; "
+                          "'#' starts a comment.");
+      }
+      prm.leave_subsection();
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Contacts");
+    {
+      prm.declare_entry("Enabled",
+                        "true",
+                        Bool(),
+                        "Resolve grain-grain and grain-wall contacts "
+                        "(non-smooth contact dynamics).");
+      prm.declare_entry("Restitution",
+                        "0",
+                        Double(0, 1),
+                        "Newton coefficient of restitution e.");
+      prm.declare_entry("Friction",
+                        "0",
+                        Double(0),
+                        "Coulomb friction coefficient; > 0 adds rotation.");
+      prm.declare_entry("Tolerance",
+                        "1e-6",
+                        Double(0),
+                        "Gauss-Seidel stops when no impulse changes by more "
+                        "than this times the largest impulse in a sweep ...");
+      prm.declare_entry("Overlap tolerance",
+                        "1e-3",
+                        Double(0),
+                        "... and the largest overlap at the end of the step "
+                        "is below this times the smallest radius.");
+      prm.declare_entry("Max iterations",
+                        "1000",
+                        Integer(1),
+                        "Cap on Gauss-Seidel sweeps per step.");
+      prm.declare_entry("Alert distance",
+                        "0",
+                        Double(0),
+                        "Pairs closer than this at the start of a step are "
+                        "contact candidates [m]; 0: automatic (a tenth of "
+                        "the smallest radius plus twice the largest "
+                        "displacement of the step).");
+      prm.declare_entry("Warm start",
+                        "true",
+                        Bool(),
+                        "Start from last step's impulses.");
+      prm.declare_entry("Stop on failure",
+                        "false",
+                        Bool(),
+                        "Stop the run when the contact solver does not "
+                        "converge within Max iterations (otherwise a warning "
+                        "in the log and contact_residual in statistics).");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Gravity");
+    prm.declare_entry("Vector",
+                      dim == 2 ? "0, -9.81" : "0, 0, -9.81",
+                      Anything(),
+                      "Gravitational acceleration g [m/s^2] (comma list).");
+    prm.leave_subsection();
+  }
+
+
+  template <int dim>
+  void
+  GrainParameters<dim>::parse_parameters(dealii::ParameterHandler &prm,
+                                         const std::string        &file_name)
+  {
+    file = file_name;
+    prm.enter_subsection("Grains");
+    {
+      const InputLocation where{file, "Grains"};
+      enabled    = prm.get_bool("Enabled");
+      radius     = prm.get_double("Radius");
+      radii_text = prm.get("Radii");
+      radii      = parse_double_list(radii_text, where, "Radii");
+      for (const double r : radii)
+        where.require(r > 0, "Radii", radii_text, "radii must be positive");
+      where.require(radius > 0,
+                    "Radius",
+                    prm.get("Radius"),
+                    "must be positive");
+      const std::string distribution = prm.get("Radius distribution");
+      radius_distribution =
+        (distribution == "uniform" ? RadiusDistribution::uniform :
+         distribution == "normal"  ? RadiusDistribution::normal :
+                                     RadiusDistribution::constant);
+      min_radius       = prm.get_double("Minimum radius");
+      max_radius       = prm.get_double("Maximum radius");
+      radius_deviation = prm.get_double("Radius deviation");
+      if (radius_distribution != RadiusDistribution::constant)
+        where.require(min_radius > 0 && max_radius >= min_radius,
+                      "Maximum radius",
+                      prm.get("Maximum radius"),
+                      "needs 0 < Minimum radius (" + prm.get("Minimum radius") +
+                        ") <= Maximum radius for Radius distribution = " +
+                        distribution);
+      if (radius_distribution == RadiusDistribution::normal)
+        where.require(radius >= min_radius && radius <= max_radius,
+                      "Radius",
+                      prm.get("Radius"),
+                      "the mean of the normal distribution must lie in "
+                      "[Minimum radius, Maximum radius]");
+      density = prm.get_double("Density");
+      where.require(density > 0,
+                    "Density",
+                    prm.get("Density"),
+                    "must be positive");
+      fixed            = prm.get_bool("Fixed");
+      max_displacement = prm.get_double("Max displacement fraction");
+      where.require(max_displacement > 0,
+                    "Max displacement fraction",
+                    prm.get("Max displacement fraction"),
+                    "must be positive");
+
+      prm.enter_subsection("Placement");
+      {
+        const InputLocation place{file, "Grains/Placement"};
+        const std::string   s = prm.get("Shape");
+        shape = (s == "ball" ? PlacementShape::ball :
+                 s == "box"  ? PlacementShape::box :
+                 s == "file" ? PlacementShape::file :
+                 s == "lattice" ? PlacementShape::lattice :
+                                  PlacementShape::list);
+        center    = parse_point<dim>(prm.get("Center"), place, "Center");
+        size_text = prm.get("Size");
+        size      = parse_double_list(size_text, place, "Size");
+        if (shape == PlacementShape::ball)
+          place.require(size.size() == 1,
+                        "Size",
+                        size_text,
+                        "a ball takes one value, its radius");
+        if (shape == PlacementShape::box || shape == PlacementShape::lattice)
+        {
+          place.require(size.size() == 1 || size.size() == dim,
+                        "Size",
+                        size_text,
+                        "a box takes one edge length or " +
+                          std::to_string(dim));
+          if (size.size() == 1)
+            size.assign(dim, size[0]);
+        }
+        for (const double v : size)
+          place.require(v > 0, "Size", size_text, "must be positive");
+        solid_fraction_text = prm.get("Solid fraction");
+        solid_fraction      = prm.get_double("Solid fraction");
+        count_text          = prm.get("Count");
+        count               = prm.get_integer("Count");
+        positions_text      = prm.get("Positions");
+        positions = parse_point_list<dim>(positions_text, place, "Positions");
+        velocities_text = prm.get("Velocities");
+        velocities =
+          parse_point_list<dim>(velocities_text, place, "Velocities");
+        random_seed    = prm.get_integer("Random seed");
+        placement_file = prm.get("File");
+        if (enabled && shape == PlacementShape::list)
+          place.require(!positions.empty(),
+                        "Positions",
+                        positions_text,
+                        "Shape = list needs at least one position");
+        if (enabled && shape == PlacementShape::file)
+          place.require(!placement_file.empty(),
+                        "File",
+                        placement_file,
+                        "Shape = file needs a file name");
+        if (enabled && (shape == PlacementShape::ball ||
+                        shape == PlacementShape::box) &&
+            count == 0 && radii.empty())
+          place.require(solid_fraction > 0 && solid_fraction < 1,
+                        "Solid fraction",
+                        solid_fraction_text,
+                        "must lie in (0, 1)");
+      }
+      prm.leave_subsection();
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Contacts");
+    {
+      const InputLocation where{file, "Contacts"};
+      contacts_enabled         = prm.get_bool("Enabled");
+      contact.restitution      = prm.get_double("Restitution");
+      contact.friction         = prm.get_double("Friction");
+      contact.tolerance        = prm.get_double("Tolerance");
+      contact.overlap_tolerance = prm.get_double("Overlap tolerance");
+      contact.max_iterations   = prm.get_integer("Max iterations");
+      contact.warm_start       = prm.get_bool("Warm start");
+      alert_distance           = prm.get_double("Alert distance");
+      stop_on_failure          = prm.get_bool("Stop on failure");
+      where.require(contact.tolerance > 0,
+                    "Tolerance",
+                    prm.get("Tolerance"),
+                    "must be positive");
+      where.require(contact.overlap_tolerance > 0,
+                    "Overlap tolerance",
+                    prm.get("Overlap tolerance"),
+                    "must be positive");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Gravity");
+    {
+      const InputLocation where{file, "Gravity"};
+      const auto          g = parse_point<dim>(prm.get("Vector"), where, "Vector");
+      for (unsigned int d = 0; d < dim; ++d)
+        gravity[d] = g[d];
+    }
+    prm.leave_subsection();
+  }
+
+
+  template struct GrainParameters<2>;
+  template struct GrainParameters<3>;
+} // namespace ImmersedGrains

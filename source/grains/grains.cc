@@ -1,0 +1,466 @@
+#include <deal.II/base/utilities.h>
+#include <deal.II/grid/filtered_iterator.h>
+#include <deal.II/grid/grid_tools.h>
+
+#include <immersed_grains/grains/grains.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    template <int dim>
+    GrainPropertyLayout
+    make_layout(const GrainParameters<dim> &prm, const bool with_fluid)
+    {
+      using namespace dealii::DataComponentInterpretation;
+      GrainPropertyLayout l;
+      const auto          add = [&](const std::string &name,
+                           const unsigned int n,
+                           const bool         vector)
+      {
+        const unsigned int first = l.n_properties;
+        for (unsigned int c = 0; c < n; ++c)
+        {
+          l.names.push_back(name);
+          l.interpretations.push_back(vector ? component_is_part_of_vector :
+                                               component_is_scalar);
+        }
+        l.n_properties += n;
+        return first;
+      };
+      l.velocity = add("velocity", dim, true);
+      l.radius   = add("radius", 1, false);
+      if (prm.contacts_enabled && prm.contact.friction > 0)
+        l.angular_velocity =
+          add("angular_velocity", dim == 2 ? 1 : 3, dim == 3);
+      if (with_fluid)
+        l.fluid_force = add("fluid_force", dim, true);
+      return l;
+    }
+  } // namespace
+
+
+  template <int dim>
+  Grains<dim>::Grains(
+    const GrainParameters<dim>                              &parameters,
+    const Geometry<dim>                                     &geometry,
+    const dealii::parallel::distributed::Triangulation<dim> &tria,
+    const bool                                               with_fluid,
+    dealii::TimerOutput                                     &timer)
+      : parameters(parameters)
+      , geometry(geometry)
+      , triangulation(tria)
+      , comm(tria.get_communicator())
+      , timer(timer)
+      , properties(make_layout(parameters, with_fluid))
+      , particles(tria, mapping, properties.n_properties)
+  {
+    if (parameters.contacts_enabled)
+      contacts = std::make_unique<DistributedContacts<dim>>(geometry,
+                                                            parameters.contact,
+                                                            comm);
+    // Grains whose centre leaves the mesh where it is not open would vanish
+    // silently in the sort; move_and_scatter() prevents it, this counts any
+    // that slip through so that they are reported.
+    particles.signals.particle_lost.connect(
+      [this](const auto &, const auto &) { ++lost; });
+    update_partition();
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::update_partition()
+  {
+    const std::function<bool(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &)>
+      owned = [](const auto &cell) { return cell->is_locally_owned(); };
+    const auto local = dealii::GridTools::compute_mesh_predicate_bounding_box<
+      dealii::Triangulation<dim>>(triangulation, owned, 1, true, 8);
+    rank_boxes = dealii::Utilities::MPI::all_gather(comm, local);
+    if (contacts)
+      contacts->set_partition(rank_boxes);
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::initialize(const std::vector<GrainSeed<dim>> &seeds)
+  {
+    dealii::TimerOutput::Scope scope(timer, "grains: setup");
+    // Rank 0 hands every grain in; insert_global_particles sends each to
+    // the rank owning its cell, with the seed's index as its id.
+    std::vector<dealii::Point<dim>>             positions;
+    std::vector<std::vector<double>>            props;
+    std::vector<dealii::types::particle_index>  ids;
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      for (unsigned int k = 0; k < seeds.size(); ++k)
+      {
+        positions.push_back(seeds[k].position);
+        std::vector<double> p(properties.n_properties, 0.);
+        for (unsigned int d = 0; d < dim; ++d)
+          p[properties.velocity + d] = parameters.fixed ? 0 : seeds[k].velocity[d];
+        p[properties.radius] = seeds[k].radius;
+        props.push_back(p);
+        ids.push_back(k);
+      }
+    particles.insert_global_particles(positions, rank_boxes, props, ids);
+    particles.update_cached_numbers();
+    AssertThrow(particles.n_global_particles() == seeds.size(),
+                dealii::ExcMessage(
+                  "Grains: " +
+                  std::to_string(seeds.size() - particles.n_global_particles()) +
+                  " grains could not be located in the mesh."));
+  }
+
+
+  template <int dim>
+  double
+  Grains<dim>::mass(const double radius) const
+  {
+    return parameters.density * grain_volume<dim>(radius);
+  }
+
+
+  template <int dim>
+  double
+  Grains<dim>::stable_time_step(const double max_step) const
+  {
+    double v_max = 0, r_min = std::numeric_limits<double>::max();
+    for (const auto &p : particles)
+    {
+      const auto     props = p.get_properties();
+      dealii::Tensor<1, dim> v;
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = props[properties.velocity + d];
+      v_max = std::max(v_max, v.norm());
+      r_min = std::min(r_min, props[properties.radius]);
+    }
+    // Gravity adds up to |g| dt within the step.
+    v_max = dealii::Utilities::MPI::max(v_max, comm) +
+            (parameters.fixed ? 0 : parameters.gravity.norm() * max_step);
+    r_min = dealii::Utilities::MPI::min(r_min, comm);
+    if (v_max <= 0 || parameters.fixed)
+      return max_step;
+    return std::min(max_step, parameters.max_displacement * r_min / v_max);
+  }
+
+
+  template <int dim>
+  GrainStepReport
+  Grains<dim>::advance(const double dt)
+  {
+    gather();
+    compute_free_velocities(dt);
+    GrainStepReport report = resolve_contacts(dt);
+    report.removed         = move_and_scatter(dt);
+    return report;
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::gather()
+  {
+    dealii::TimerOutput::Scope scope(timer, "grains: gather");
+    const unsigned int n        = particles.n_locally_owned_particles();
+    const bool         friction = properties.angular_velocity !=
+                          GrainPropertyLayout::absent;
+    auto &c = arrays.contact;
+    arrays.position.resize(n);
+    arrays.mass.resize(n);
+    c.velocity.resize(n);
+    c.start_velocity.resize(n);
+    c.inverse_mass.resize(n);
+    c.radius.resize(n);
+    c.id.resize(n);
+    c.angular_velocity.resize(friction ? n : 0);
+    c.inverse_inertia.resize(friction ? n : 0);
+    arrays.external_force.clear();
+    arrays.drag_coefficient.clear();
+    arrays.drag_velocity.clear();
+
+    unsigned int i = 0;
+    for (const auto &p : particles)
+    {
+      const auto props   = p.get_properties();
+      arrays.position[i] = p.get_location();
+      for (unsigned int d = 0; d < dim; ++d)
+        c.velocity[i][d] = props[properties.velocity + d];
+      c.radius[i]     = props[properties.radius];
+      c.id[i]         = p.get_id();
+      arrays.mass[i]  = mass(c.radius[i]);
+      if (friction)
+        for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
+          c.angular_velocity[i][d] = props[properties.angular_velocity + d];
+      ++i;
+    }
+    c.start_velocity = c.velocity;
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::compute_free_velocities(const double dt)
+  {
+    dealii::TimerOutput::Scope scope(timer, "grains: free velocities");
+    // Implicit drag (hooks): m (v' - v) = dt (m g + F + beta (u - v')), so
+    // v' = (m v + dt (m g + F + beta u)) / (m + dt beta), and the contact
+    // solver sees the same effective mass m + dt beta.
+    auto              &c        = arrays.contact;
+    const bool         force    = !arrays.external_force.empty();
+    const bool         drag     = !arrays.drag_coefficient.empty();
+    const bool         friction = !c.inverse_inertia.empty();
+    const unsigned int n        = c.velocity.size();
+    for (unsigned int i = 0; i < n; ++i)
+    {
+      const double m = arrays.mass[i];
+      if (parameters.fixed)
+      {
+        c.velocity[i]     = 0;
+        c.inverse_mass[i] = 0;
+        if (friction)
+        {
+          c.angular_velocity[i] = 0;
+          c.inverse_inertia[i]  = 0;
+        }
+        continue;
+      }
+      dealii::Tensor<1, dim> momentum = m * (c.velocity[i] + dt * parameters.gravity);
+      double                 m_eff    = m;
+      if (force)
+        momentum += dt * arrays.external_force[i];
+      if (drag)
+      {
+        momentum += dt * arrays.drag_coefficient[i] * arrays.drag_velocity[i];
+        m_eff += dt * arrays.drag_coefficient[i];
+      }
+      c.velocity[i]     = momentum / m_eff;
+      c.inverse_mass[i] = 1 / m_eff;
+      if (friction)
+        c.inverse_inertia[i] = 1 / (m * inertia_per_mass<dim>(c.radius[i]));
+    }
+  }
+
+
+  template <int dim>
+  GrainStepReport
+  Grains<dim>::resolve_contacts(const double dt)
+  {
+    GrainStepReport report;
+    if (!contacts)
+      return report;
+    dealii::TimerOutput::Scope scope(timer, "grains: contacts");
+    auto  &c     = arrays.contact;
+    double v_max = 0, r_min = std::numeric_limits<double>::max();
+    for (unsigned int i = 0; i < c.velocity.size(); ++i)
+    {
+      v_max = std::max(v_max, c.velocity[i].norm());
+      r_min = std::min(r_min, c.radius[i]);
+    }
+    v_max = dealii::Utilities::MPI::max(v_max, comm);
+    r_min = dealii::Utilities::MPI::min(r_min, comm);
+    // Two grains close at most 2 v_max dt within the step (NSCD's
+    // candidates are fixed at its start); the margin covers speed gained
+    // in collisions.
+    report.alert_distance = parameters.alert_distance > 0 ?
+                              parameters.alert_distance :
+                              0.1 * r_min + 3 * v_max * dt;
+    report.contacts =
+      contacts->solve(arrays.position, c, dt, report.alert_distance);
+    report.max_contact_force = contacts->max_contact_force();
+    AssertThrow(report.contacts.converged || !parameters.stop_on_failure,
+                dealii::ExcMessage(
+                  "the contact solver did not converge within " +
+                  std::to_string(report.contacts.iterations) +
+                  " iterations (residual " +
+                  std::to_string(report.contacts.residual) +
+                  "); Contacts/Stop on failure is set"));
+    return report;
+  }
+
+
+  template <int dim>
+  unsigned long
+  Grains<dim>::move_and_scatter(const double dt)
+  {
+    dealii::TimerOutput::Scope scope(timer, "grains: move and sort");
+    const auto   &c        = arrays.contact;
+    const bool    friction = !c.angular_velocity.empty();
+    const auto   &lo       = geometry.lower_corner;
+    const auto   &hi       = geometry.upper_corner;
+    std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator>
+                 leaving;
+    unsigned int i = 0;
+    for (auto p = particles.begin(); p != particles.end(); ++p, ++i)
+    {
+      dealii::Point<dim> x = arrays.position[i] + dt * c.velocity[i];
+      bool               left = false;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double L = hi[d] - lo[d];
+        if (geometry.is_periodic(d))
+        {
+          // Wrap into [lo, hi).
+          x[d] = lo[d] + std::fmod(std::fmod(x[d] - lo[d], L) + L, L);
+          if (x[d] >= hi[d])
+            x[d] = lo[d];
+          continue;
+        }
+        for (unsigned int side = 0; side < 2; ++side)
+        {
+          const bool beyond = side == 0 ? x[d] < lo[d] : x[d] > hi[d];
+          if (!beyond)
+            continue;
+          if (geometry.boundary_types[2 * d + side] == BoundaryType::open)
+            left = true;
+          else
+            // The centre went through a wall (a grain overlapping it by
+            // more than its radius): keep it just inside, the next
+            // contact step pushes it out, rather than losing it.
+            x[d] = side == 0 ? lo[d] + 1e-9 * L : hi[d] - 1e-9 * L;
+        }
+      }
+      if (left)
+      {
+        leaving.push_back(p);
+        continue;
+      }
+      p->set_location(x);
+      auto props = p->get_properties();
+      for (unsigned int d = 0; d < dim; ++d)
+        props[properties.velocity + d] = c.velocity[i][d];
+      if (friction)
+        for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
+          props[properties.angular_velocity + d] = c.angular_velocity[i][d];
+    }
+    particles.remove_particles(leaving);
+    particles.sort_particles_into_subdomains_and_cells();
+    const unsigned long removed =
+      dealii::Utilities::MPI::sum<unsigned long>(leaving.size(), comm);
+    removed_total += removed;
+    return removed;
+  }
+
+
+  template <int dim>
+  GrainStepArrays<dim> &
+  Grains<dim>::step_arrays()
+  {
+    return arrays;
+  }
+
+
+  template <int dim>
+  GrainStatistics<dim>
+  Grains<dim>::compute_statistics() const
+  {
+    // Sums over owned grains: count, volume, sum x, sum v, kinetic energy,
+    // volume-weighted height along gravity; then one reduction.
+    const bool friction =
+      properties.angular_velocity != GrainPropertyLayout::absent;
+    const dealii::Tensor<1, dim> down =
+      parameters.gravity.norm() > 0 ? parameters.gravity / parameters.gravity.norm() :
+                                      dealii::Tensor<1, dim>();
+    unsigned int axis = 0;
+    for (unsigned int d = 1; d < dim; ++d)
+      if (std::abs(down[d]) > std::abs(down[axis]))
+        axis = d;
+    const double floor = down[axis] < 0 ? geometry.lower_corner[axis] :
+                                          geometry.upper_corner[axis];
+    std::vector<double> sums(3 + 2 * dim + 1, 0.);
+    double              max_speed = 0;
+    for (const auto &p : particles)
+    {
+      const auto   props = p.get_properties();
+      const double r     = props[properties.radius];
+      const double V     = grain_volume<dim>(r);
+      const double m     = mass(r);
+      dealii::Tensor<1, dim> v;
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = props[properties.velocity + d];
+      double rotation = 0;
+      if (friction)
+        for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
+          rotation += dealii::Utilities::fixed_power<2>(
+            props[properties.angular_velocity + d]);
+      sums[0] += 1;
+      sums[1] += V;
+      sums[2] += 0.5 * m * (v * v + inertia_per_mass<dim>(r) * rotation);
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        sums[3 + d] += p.get_location()[d];
+        sums[3 + dim + d] += v[d];
+      }
+      // Height above the floor the grains rest on (the face gravity points
+      // to), weighted by volume.
+      sums[3 + 2 * dim] += V * std::abs(p.get_location()[axis] - floor);
+      max_speed = std::max(max_speed, v.norm());
+    }
+    dealii::Utilities::MPI::sum(sums, comm, sums);
+
+    GrainStatistics<dim> s;
+    s.n_grains       = sums[0];
+    s.solid_volume   = sums[1];
+    s.kinetic_energy = sums[2];
+    s.max_speed      = dealii::Utilities::MPI::max(max_speed, comm);
+    if (s.n_grains > 0)
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        s.centroid[d]      = sums[3 + d] / s.n_grains;
+        s.mean_velocity[d] = sums[3 + dim + d] / s.n_grains;
+      }
+    // Bulk packing fraction of a bed resting on the floor: its volume over
+    // the cross-section times twice the volume-weighted centroid height
+    // (exact for a uniform bed with a flat top).
+    if (down.norm() > 0 && s.solid_volume > 0)
+    {
+      double section = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        if (d != axis)
+          section *= geometry.upper_corner[d] - geometry.lower_corner[d];
+      const double height = sums[3 + 2 * dim] / s.solid_volume;
+      s.packing_fraction = height > 0 ? s.solid_volume / (section * 2 * height) : 0;
+    }
+    return s;
+  }
+
+
+  template <int dim>
+  const dealii::Particles::ParticleHandler<dim> &
+  Grains<dim>::particle_handler() const
+  {
+    return particles;
+  }
+
+
+  template <int dim>
+  const GrainPropertyLayout &
+  Grains<dim>::layout() const
+  {
+    return properties;
+  }
+
+
+  template <int dim>
+  std::vector<ContactForce>
+  Grains<dim>::contact_forces() const
+  {
+    return contacts ? contacts->contact_forces() : std::vector<ContactForce>();
+  }
+
+
+  template <int dim>
+  unsigned long
+  Grains<dim>::n_removed() const
+  {
+    return removed_total;
+  }
+
+
+  template class Grains<2>;
+  template class Grains<3>;
+} // namespace ImmersedGrains

@@ -1,0 +1,503 @@
+#include <deal.II/base/utilities.h>
+
+#include <immersed_grains/contact/bucket_grid.h>
+#include <immersed_grains/grains/placement.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    using dealii::Point;
+    using dealii::Tensor;
+
+    // std::mt19937_64 is fully specified by the standard, the library's
+    // distributions are not: draw through these so that a seed gives the
+    // same grains with any compiler.
+    struct Random
+    {
+      std::mt19937_64 engine;
+
+      double
+      uniform()
+      {
+        return (engine() >> 11) * 0x1.0p-53;
+      }
+
+      double
+      uniform(const double a, const double b)
+      {
+        return a + (b - a) * uniform();
+      }
+
+      double
+      normal(const double mean, const double deviation)
+      {
+        // Box-Muller; 1 - u keeps the logarithm finite.
+        const double u = 1 - uniform(), v = uniform();
+        return mean + deviation * std::sqrt(-2 * std::log(u)) *
+                        std::cos(2 * M_PI * v);
+      }
+    };
+
+    template <int dim>
+    std::string
+    to_text(const Point<dim> &p)
+    {
+      std::ostringstream s;
+      s << '(' << p << ')';
+      return s.str();
+    }
+
+    template <int dim>
+    double
+    draw_radius(const GrainParameters<dim> &prm, Random &random)
+    {
+      switch (prm.radius_distribution)
+      {
+        case RadiusDistribution::uniform:
+          return random.uniform(prm.min_radius, prm.max_radius);
+        case RadiusDistribution::normal:
+          for (;;)
+          {
+            const double r = random.normal(prm.radius, prm.radius_deviation);
+            if (r >= prm.min_radius && r <= prm.max_radius)
+              return r;
+          }
+        default:
+          return prm.radius;
+      }
+    }
+
+    // The radii of a ball or box fill: Radii, Count draws, or draws until
+    // the solid fraction of the region is reached.
+    template <int dim>
+    std::vector<double>
+    fill_radii(const GrainParameters<dim> &prm,
+               const double                region_volume,
+               Random                     &random)
+    {
+      if (!prm.radii.empty())
+        return prm.radii;
+      std::vector<double> radii;
+      if (prm.count > 0)
+      {
+        for (unsigned int k = 0; k < prm.count; ++k)
+          radii.push_back(draw_radius(prm, random));
+        return radii;
+      }
+      const InputLocation where{prm.file, "Grains/Placement"};
+      double              volume = 0;
+      while (volume < prm.solid_fraction * region_volume)
+      {
+        radii.push_back(draw_radius(prm, random));
+        volume += grain_volume<dim>(radii.back());
+        where.require(radii.size() < 50'000'000,
+                      "Solid fraction",
+                      prm.solid_fraction_text,
+                      "more than 5e7 grains: check Size and Radius");
+      }
+      return radii;
+    }
+
+    // Random sequential addition into a ball or box, largest grains first.
+    template <int dim>
+    std::vector<GrainSeed<dim>>
+    random_fill(const GrainParameters<dim> &prm, Random &random)
+    {
+      const InputLocation where{prm.file, "Grains/Placement"};
+      const bool          ball = (prm.shape == PlacementShape::ball);
+      Point<dim>          lower, upper;
+      double              region_volume = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double half = ball ? prm.size[0] : prm.size[d] / 2;
+        lower[d]          = prm.center[d] - half;
+        upper[d]          = prm.center[d] + half;
+        region_volume *= 2 * half;
+      }
+      if (ball)
+        region_volume = grain_volume<dim>(prm.size[0]);
+
+      std::vector<double> radii = fill_radii(prm, region_volume, random);
+      std::sort(radii.begin(), radii.end(), std::greater<double>());
+      const double r_max = radii.empty() ? 0 : radii.front();
+      // What the entry that set the number of grains is called.
+      const std::string what  = !prm.radii.empty() ? "Radii" :
+                                prm.count > 0      ? "Count" :
+                                                     "Solid fraction";
+      const std::string value = !prm.radii.empty() ? prm.radii_text :
+                                prm.count > 0      ? prm.count_text :
+                                                     prm.solid_fraction_text;
+      for (unsigned int d = 0; d < dim; ++d)
+        where.require(upper[d] - lower[d] > 2 * r_max,
+                      "Size",
+                      prm.size_text,
+                      "the region is narrower than the largest grain");
+      double total = 0;
+      for (const double r : radii)
+        total += grain_volume<dim>(r);
+      where.require(total < region_volume,
+                    what,
+                    value,
+                    "the grains' volume exceeds the region's");
+
+      // Hash grid of placed grains, cell edge 2 r_max: overlaps can only be
+      // with grains in the 3^dim cells around.
+      std::array<unsigned int, dim> n_cells;
+      unsigned int                  n_total = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        n_cells[d] = std::max(1.,
+                              std::min(1e3,
+                                       std::floor((upper[d] - lower[d]) /
+                                                  (2 * r_max))));
+        n_total *= n_cells[d];
+      }
+      std::vector<std::vector<unsigned int>> cells(n_total);
+      const auto cell_of = [&](const Point<dim> &x, std::array<int, dim> &c)
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          c[d] = std::min<int>(n_cells[d] - 1,
+                               std::max(0.,
+                                        (x[d] - lower[d]) /
+                                          (upper[d] - lower[d]) * n_cells[d]));
+      };
+      const auto index = [&](const std::array<int, dim> &c)
+      {
+        unsigned int k = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          k = k * n_cells[d] + c[d];
+        return k;
+      };
+
+      std::vector<GrainSeed<dim>> grains;
+      grains.reserve(radii.size());
+      const unsigned int max_tries = 5000;
+      for (const double r : radii)
+      {
+        bool placed = false;
+        for (unsigned int t = 0; t < max_tries && !placed; ++t)
+        {
+          Point<dim> x;
+          for (unsigned int d = 0; d < dim; ++d)
+            x[d] = random.uniform(lower[d] + r, upper[d] - r);
+          if (ball && (x - prm.center).norm() > prm.size[0] - r)
+            continue;
+          std::array<int, dim> c;
+          cell_of(x, c);
+          bool free = true;
+          // Visit the 3^dim neighbour cells.
+          for (unsigned int k = 0; k < std::pow(3, dim) && free; ++k)
+          {
+            std::array<int, dim> n = c;
+            unsigned int         q = k;
+            bool                 inside = true;
+            for (unsigned int d = 0; d < dim; ++d, q /= 3)
+            {
+              n[d] += int(q % 3) - 1;
+              inside = inside && n[d] >= 0 && n[d] < int(n_cells[d]);
+            }
+            if (!inside)
+              continue;
+            for (const unsigned int j : cells[index(n)])
+              if ((grains[j].position - x).norm() < grains[j].radius + r)
+              {
+                free = false;
+                break;
+              }
+          }
+          if (!free)
+            continue;
+          cells[index(c)].push_back(grains.size());
+          grains.push_back({x, Tensor<1, dim>(), r});
+          placed = true;
+        }
+        if (!placed)
+        {
+          double placed_volume = 0;
+          for (const auto &g : grains)
+            placed_volume += grain_volume<dim>(g.radius);
+          where.fail(what,
+                     value,
+                     "random sequential addition found room for only " +
+                       std::to_string(grains.size()) + " of " +
+                       std::to_string(radii.size()) +
+                       " grains (solid fraction " +
+                       std::to_string(placed_volume / region_volume) +
+                       "; it jams near " + (dim == 2 ? "0.547" : "0.38") +
+                       " for equal grains): lower it, enlarge the region "
+                       "or use Shape = lattice");
+        }
+      }
+      return grains;
+    }
+
+    template <int dim>
+    std::vector<GrainSeed<dim>>
+    lattice_fill(const GrainParameters<dim> &prm, Random &random)
+    {
+      const InputLocation where{prm.file, "Grains/Placement"};
+      std::vector<double> radii = prm.radii;
+      double              r_max =
+        prm.radius_distribution == RadiusDistribution::constant ?
+                       prm.radius :
+                       prm.max_radius;
+      if (!radii.empty())
+        r_max = *std::max_element(radii.begin(), radii.end());
+      std::array<unsigned int, dim> n;
+      unsigned int                  sites = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        n[d] = std::floor(prm.size[d] / (2 * r_max) * (1 + 1e-12));
+        sites *= n[d];
+      }
+      where.require(sites > 0,
+                    "Size",
+                    prm.size_text,
+                    "the box is narrower than a grain diameter");
+      unsigned int count = !radii.empty() ? radii.size() :
+                           prm.count > 0  ? prm.count :
+                                            sites;
+      where.require(count <= sites,
+                    radii.empty() ? "Count" : "Radii",
+                    radii.empty() ? prm.count_text : prm.radii_text,
+                    "the lattice in the box has only " +
+                      std::to_string(sites) + " sites");
+      std::vector<GrainSeed<dim>> grains;
+      for (unsigned int k = 0; k < count; ++k)
+      {
+        Point<dim>   x;
+        unsigned int q = k;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          x[d] = prm.center[d] - prm.size[d] / 2 + r_max +
+                 2 * r_max * (q % n[d]);
+          q /= n[d];
+        }
+        const double r = radii.empty() ? draw_radius(prm, random) : radii[k];
+        grains.push_back({x, Tensor<1, dim>(), r});
+      }
+      return grains;
+    }
+
+    template <int dim>
+    std::vector<GrainSeed<dim>>
+    read_file(const GrainParameters<dim> &prm)
+    {
+      const InputLocation where{prm.file, "Grains/Placement"};
+      std::ifstream       in(prm.placement_file);
+      where.require(bool(in), "File", prm.placement_file, "cannot open it");
+      std::vector<GrainSeed<dim>> grains;
+      unsigned int                line_number = 0;
+      for (std::string line; std::getline(in, line);)
+      {
+        ++line_number;
+        line = line.substr(0, line.find('#'));
+        std::replace(line.begin(), line.end(), ',', ' ');
+        std::istringstream  words(line);
+        std::vector<double> v;
+        std::string         word;
+        while (words >> word)
+        {
+          std::istringstream number(word);
+          double             x;
+          std::string        rest;
+          if (!(number >> x) || (number >> rest))
+            where.fail("File",
+                       prm.placement_file,
+                       "line " + std::to_string(line_number) + ": '" + word +
+                         "' is not a number");
+          v.push_back(x);
+        }
+        if (v.empty())
+          continue;
+        if (v.size() != dim && v.size() != dim + 1 && v.size() != 2 * dim + 1)
+          where.fail("File",
+                     prm.placement_file,
+                     "line " + std::to_string(line_number) + ": expected " +
+                       std::to_string(dim) + ", " + std::to_string(dim + 1) +
+                       " or " + std::to_string(2 * dim + 1) +
+                       " numbers (x[, r[, v]]), got " +
+                       std::to_string(v.size()));
+        GrainSeed<dim> g{Point<dim>(), Tensor<1, dim>(), prm.radius};
+        for (unsigned int d = 0; d < dim; ++d)
+          g.position[d] = v[d];
+        if (v.size() > dim)
+          g.radius = v[dim];
+        if (v.size() > dim + 1)
+          for (unsigned int d = 0; d < dim; ++d)
+            g.velocity[d] = v[dim + 1 + d];
+        if (!(g.radius > 0))
+          where.fail("File",
+                     prm.placement_file,
+                     "line " + std::to_string(line_number) +
+                       ": the radius must be positive");
+        grains.push_back(g);
+      }
+      where.require(!grains.empty(),
+                    "File",
+                    prm.placement_file,
+                    "holds no grains");
+      return grains;
+    }
+
+    // Input grains must not overlap (touching is fine): names the first
+    // offending pair.
+    template <int dim>
+    void
+    check_overlaps(const std::vector<GrainSeed<dim>> &grains,
+                   const Geometry<dim>               &geometry,
+                   const InputLocation               &where,
+                   const std::string                 &parameter,
+                   const std::string                 &value)
+    {
+      std::vector<Point<dim>> x;
+      std::vector<double>     r;
+      double                  r_min = 1e300;
+      for (const auto &g : grains)
+      {
+        Point<dim> p = g.position;
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] = std::clamp(p[d],
+                            geometry.lower_corner[d],
+                            geometry.upper_corner[d]);
+        x.push_back(p);
+        r.push_back(g.radius);
+        r_min = std::min(r_min, g.radius);
+      }
+      // Periodic overlaps are only checked where the axis is long enough
+      // for the bucket grid; shorter periodic boxes are rejected later.
+      std::array<bool, dim> periodic;
+      double                r_max = *std::max_element(r.begin(), r.end());
+      for (unsigned int d = 0; d < dim; ++d)
+        periodic[d] = geometry.is_periodic(d) &&
+                      geometry.upper_corner[d] - geometry.lower_corner[d] >=
+                        4 * r_max;
+      Contact::BucketGrid<dim> grid(geometry.lower_corner,
+                                    geometry.upper_corner,
+                                    periodic);
+      std::vector<Contact::GrainPair<dim>> pairs;
+      grid.find_pairs(x, r, 0, pairs);
+      for (const auto &p : pairs)
+        if (p.gap < -1e-9 * r_min)
+          where.fail(parameter,
+                     value,
+                     "grains " + std::to_string(p.first + 1) + " at " +
+                       to_text(grains[p.first].position) + " and " +
+                       std::to_string(p.second + 1) + " at " +
+                       to_text(grains[p.second].position) + " overlap by " +
+                       std::to_string(-p.gap) + " m");
+    }
+
+    template <int dim>
+    void
+    check_inside(const std::vector<GrainSeed<dim>> &grains,
+                 const Geometry<dim>               &geometry,
+                 const InputLocation               &where,
+                 const std::string                 &parameter,
+                 const std::string                 &value)
+    {
+      const auto &lo = geometry.lower_corner;
+      const auto &hi = geometry.upper_corner;
+      for (unsigned int k = 0; k < grains.size(); ++k)
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double x   = grains[k].position[d];
+          const double r   = geometry.is_periodic(d) ? 0 : grains[k].radius;
+          const double eps = 1e-12 * (hi[d] - lo[d]);
+          if (x - r < lo[d] - eps || x + r > hi[d] + eps ||
+              (geometry.is_periodic(d) && x >= hi[d]))
+            where.fail(parameter,
+                       value,
+                       "grain " + std::to_string(k + 1) + " at " +
+                         to_text(grains[k].position) + " with radius " +
+                         std::to_string(grains[k].radius) +
+                         " is not inside the domain " + to_text(lo) + " - " +
+                         to_text(hi));
+        }
+    }
+  } // namespace
+
+
+  template <int dim>
+  std::vector<GrainSeed<dim>>
+  place_grains(const GrainParameters<dim> &prm, const Geometry<dim> &geometry)
+  {
+    const InputLocation place{prm.file, "Grains/Placement"};
+    Random              random{std::mt19937_64(prm.random_seed)};
+
+    std::vector<GrainSeed<dim>> grains;
+    std::string                 parameter, value;
+    switch (prm.shape)
+    {
+      case PlacementShape::ball:
+      case PlacementShape::box:
+        grains    = random_fill(prm, random);
+        parameter = "Size";
+        value     = prm.size_text;
+        break;
+      case PlacementShape::lattice:
+        grains    = lattice_fill(prm, random);
+        parameter = "Size";
+        value     = prm.size_text;
+        break;
+      case PlacementShape::list:
+        for (const auto &x : prm.positions)
+          grains.push_back({x, Tensor<1, dim>(), prm.radius});
+        parameter = "Positions";
+        value     = prm.positions_text;
+        if (!prm.radii.empty())
+        {
+          const InputLocation g{prm.file, "Grains"};
+          g.require(prm.radii.size() == grains.size(),
+                    "Radii",
+                    prm.radii_text,
+                    "expected one radius per position (" +
+                      std::to_string(grains.size()) + ")");
+          for (unsigned int k = 0; k < grains.size(); ++k)
+            grains[k].radius = prm.radii[k];
+        }
+        break;
+      case PlacementShape::file:
+        grains    = read_file(prm);
+        parameter = "File";
+        value     = prm.placement_file;
+        break;
+    }
+
+    if (!prm.velocities.empty())
+    {
+      place.require(prm.velocities.size() == 1 ||
+                      prm.velocities.size() == grains.size(),
+                    "Velocities",
+                    prm.velocities_text,
+                    "give one velocity for all grains or one per grain (" +
+                      std::to_string(grains.size()) + ")");
+      for (unsigned int k = 0; k < grains.size(); ++k)
+      {
+        const Point<dim> &v = prm.velocities[prm.velocities.size() == 1 ? 0 : k];
+        for (unsigned int d = 0; d < dim; ++d)
+          grains[k].velocity[d] = v[d];
+      }
+    }
+
+    if (grains.empty())
+      return grains;
+    check_inside(grains, geometry, place, parameter, value);
+    if (prm.shape != PlacementShape::ball && prm.shape != PlacementShape::box)
+      check_overlaps(grains, geometry, place, parameter, value);
+    return grains;
+  }
+
+
+  template std::vector<GrainSeed<2>>
+  place_grains(const GrainParameters<2> &, const Geometry<2> &);
+  template std::vector<GrainSeed<3>>
+  place_grains(const GrainParameters<3> &, const Geometry<3> &);
+} // namespace ImmersedGrains
