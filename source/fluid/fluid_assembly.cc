@@ -1,3 +1,4 @@
+#include <deal.II/base/qprojector.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
 
@@ -51,6 +52,14 @@ namespace ImmersedGrains
       dealii::update_values | dealii::update_normal_vectors |
         dealii::update_quadrature_points | dealii::update_JxW_values);
 
+    // Face quadrature points in reference-cell coordinates, per face.
+    std::vector<std::vector<dealii::Point<dim>>> face_reference_points;
+    for (const unsigned int f : dealii::GeometryInfo<dim>::face_indices())
+      face_reference_points.push_back(
+        dealii::QProjector<dim>::project_to_face(
+          dealii::ReferenceCells::get_hypercube<dim>(), face_quadrature, f)
+          .get_points());
+
     const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
     const unsigned int n_q           = quadrature.size();
     const dealii::FEValuesExtractors::Vector velocities(0);
@@ -98,6 +107,7 @@ namespace ImmersedGrains
 
       mixture_fields->evaluate(cell,
                                fe_values.get_quadrature_points(),
+                               quadrature.get_points(),
                                time,
                                mixture);
       fe_values[velocities].get_function_values(solution, u);
@@ -202,6 +212,7 @@ namespace ImmersedGrains
         MixtureValues<dim> face_mixture;
         mixture_fields->evaluate(cell,
                                  fe_face_values.get_quadrature_points(),
+                                 face_reference_points[face_no],
                                  time,
                                  face_mixture);
         for (unsigned int q = 0; q < face_quadrature.size(); ++q)

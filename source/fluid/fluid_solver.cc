@@ -55,8 +55,12 @@ namespace ImmersedGrains
         std::vector<dealii::Vector<double>> &computed) const override
       {
         const auto         cell = inputs.template get_cell<dim>();
-        MixtureValues<dim> values;
-        fields.evaluate(cell, inputs.evaluation_points, time, values);
+        MixtureValues<dim>              values;
+        std::vector<dealii::Point<dim>> reference(inputs.evaluation_points.size());
+        for (unsigned int q = 0; q < reference.size(); ++q)
+          reference[q] = mapping.transform_real_to_unit_cell(
+            cell, inputs.evaluation_points[q]);
+        fields.evaluate(cell, inputs.evaluation_points, reference, time, values);
         for (unsigned int q = 0; q < computed.size(); ++q)
         {
           computed[q](0) = values.fluid_fraction[q];
@@ -77,8 +81,9 @@ namespace ImmersedGrains
       }
 
     private:
-      const MixtureFields<dim> &fields;
-      const double              time;
+      const MixtureFields<dim>     &fields;
+      const double                  time;
+      const dealii::MappingQ1<dim> mapping;
     };
   } // namespace
 
@@ -551,6 +556,7 @@ namespace ImmersedGrains
         fe_values.reinit(cell);
         mixture_fields->evaluate(cell,
                                  fe_values.get_quadrature_points(),
+                                 quadrature.get_points(),
                                  time,
                                  values);
         for (unsigned int q = 0; q < quadrature.size(); ++q)

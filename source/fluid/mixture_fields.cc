@@ -34,6 +34,7 @@ namespace ImmersedGrains
   PrescribedMixtureFields<dim>::evaluate(
     const typename dealii::Triangulation<dim>::active_cell_iterator &,
     const std::vector<dealii::Point<dim>> &points,
+    const std::vector<dealii::Point<dim>> &,
     const double                           time,
     MixtureValues<dim>                    &values) const
   {

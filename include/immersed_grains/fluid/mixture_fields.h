@@ -43,12 +43,17 @@ namespace ImmersedGrains
   public:
     virtual ~MixtureFields() = default;
 
+    /**
+     * Values at @p points (physical) of @p cell, whose coordinates in the
+     * reference cell are @p reference_points.
+     */
     virtual void
     evaluate(
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>>                           &points,
-      double                                                           time,
-      MixtureValues<dim> &values) const = 0;
+      const std::vector<dealii::Point<dim>> &reference_points,
+      double                                 time,
+      MixtureValues<dim>                    &values) const = 0;
   };
 
 
@@ -71,8 +76,9 @@ namespace ImmersedGrains
     evaluate(
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>>                           &points,
-      double                                                           time,
-      MixtureValues<dim> &values) const override;
+      const std::vector<dealii::Point<dim>> &reference_points,
+      double                                 time,
+      MixtureValues<dim>                    &values) const override;
 
   private:
     std::shared_ptr<dealii::Function<dim>> fluid_fraction;

@@ -1,0 +1,129 @@
+#ifndef immersed_grains_coupling_solid_fraction_h
+#define immersed_grains_coupling_solid_fraction_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/tensor.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <immersed_grains/fluid/mixture_fields.h>
+#include <immersed_grains/mesh/geometry.h>
+
+#include <array>
+#include <functional>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /** One grain as the projection sees it. */
+  template <int dim>
+  struct GrainSample
+  {
+    dealii::Point<dim>     reference_location; // in its cell
+    double                 volume;
+    dealii::Tensor<1, dim> velocity;
+  };
+
+  /**
+   * The solid fraction phi_s = 1 - phi and the solid volume flux
+   * (1 - phi) u_p on Q1, projected from the grains:
+   *
+   *   (M + l^2 K) phi_s = b,   b_j = sum_i V_i N_j(x_i),
+   *
+   * with M the consistent or the lumped (row-sum) mass matrix and l the
+   * smoothing length (0: plain L2 projection). Since K 1 = 0 and the N_j
+   * sum to one, the integral of phi_s equals the grains' total volume
+   * whatever M, l, the mesh or the partition (up to the linear solver's
+   * tolerance, 1e-14 relative): the projection conserves volume. The same
+   * operator maps the grains' momentum-volume V_i v_i to the flux field.
+   * doc/theory.md shows what the smoothing does to the field.
+   */
+  template <int dim>
+  class SolidFraction : public MixtureFields<dim>
+  {
+  public:
+    struct Parameters
+    {
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
+
+      bool   lumped               = false;
+      double smoothing_length     = 0;
+      double min_fluid_fraction   = 0.3;
+    };
+
+    SolidFraction(const Parameters                                        &parameters,
+                  const Geometry<dim>                                     &geometry,
+                  const dealii::parallel::distributed::Triangulation<dim> &tria);
+
+    /** (Re)builds DoFs and matrices; call after every mesh change. */
+    void
+    setup();
+
+    /**
+     * Fills the fields from @p samples, which lists the grains of each
+     * locally owned cell.
+     */
+    void
+    project(const std::function<void(
+              const typename dealii::Triangulation<dim>::active_cell_iterator &,
+              std::vector<GrainSample<dim>> &)> &samples);
+
+    /** Integral of phi_s over the mesh. */
+    double
+    integral() const;
+
+    /** Number of Q1 nodes where phi was clamped to the minimum. */
+    unsigned int
+    n_clamped() const;
+
+    /**
+     * MixtureFields: phi = max(1 - phi_s, min), its gradient, the grain
+     * velocity flux/phi_s and div of the flux; no continuous drag (the
+     * grains' drag enters as point terms).
+     */
+    void
+    evaluate(const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+             const std::vector<dealii::Point<dim>> &points,
+             const std::vector<dealii::Point<dim>> &reference_points,
+             double                                 time,
+             MixtureValues<dim>                    &values) const override;
+
+    const dealii::DoFHandler<dim> &
+    get_dof_handler() const;
+
+    /** Ghosted phi_s. */
+    const dealii::TrilinosWrappers::MPI::Vector &
+    solid_fraction() const;
+
+  private:
+    void
+    solve(const dealii::TrilinosWrappers::MPI::Vector &rhs,
+          dealii::TrilinosWrappers::MPI::Vector       &ghosted_result);
+
+    const Parameters                                        &parameters;
+    const dealii::parallel::distributed::Triangulation<dim> &triangulation;
+    const Geometry<dim>                                     &geometry;
+    dealii::FE_Q<dim>                                        fe;
+    dealii::DoFHandler<dim>                                  dof_handler;
+    dealii::MappingQ1<dim>                                   mapping;
+    dealii::AffineConstraints<double>                        constraints;
+    dealii::IndexSet                                         owned, relevant;
+
+    dealii::TrilinosWrappers::SparseMatrix matrix; // M + l^2 K (or lumped)
+    dealii::TrilinosWrappers::MPI::Vector  lumped_inverse;
+
+    dealii::TrilinosWrappers::MPI::Vector                       fraction;
+    std::array<dealii::TrilinosWrappers::MPI::Vector, dim>       flux;
+    unsigned int                                                clamped = 0;
+  };
+} // namespace ImmersedGrains
+
+#endif
