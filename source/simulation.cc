@@ -120,6 +120,7 @@ namespace ImmersedGrains
 
     Geometry<dim>::declare_parameters(prm);
     FluidParameters<dim>::declare_parameters(prm);
+    Coupling<dim>::Parameters::declare_parameters(prm);
     GrainParameters<dim>::declare_parameters(prm);
   }
 
@@ -132,10 +133,7 @@ namespace ImmersedGrains
       , parameter_file(file)
       , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       , statistics(statistics_columns(dim))
-      , triangulation(comm,
-                      dealii::Triangulation<dim>::maximum_smoothing,
-                      dealii::parallel::distributed::Triangulation<
-                        dim>::construct_multigrid_hierarchy)
+      , triangulation(comm, dealii::Triangulation<dim>::maximum_smoothing)
       , wall_start(now())
   {
     const InputLocation top{file, ""};
@@ -176,6 +174,7 @@ namespace ImmersedGrains
     geometry.parse_parameters(prm, file);
     fluid_parameters.parse_parameters(prm, file, geometry);
     grain_parameters.parse_parameters(prm, file);
+    coupling_parameters.parse_parameters(prm, file);
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
   }
@@ -266,6 +265,25 @@ namespace ImmersedGrains
       pcout << '\n';
       grain_seeds.clear();
     }
+
+    if (fluid && grains)
+    {
+      coupling = std::make_unique<Coupling<dim>>(coupling_parameters,
+                                                 grain_parameters,
+                                                 geometry,
+                                                 triangulation,
+                                                 fluid_parameters.density,
+                                                 fluid_parameters.viscosity,
+                                                 *timer);
+      coupling->setup();
+      coupling->attach(*fluid);
+      coupling->project(*grains);
+      pcout << "  coupling: drag law " << coupling_parameters.drag_law
+            << (coupling_parameters.tracers ?
+                  ", tracers" :
+                  (coupling_parameters.two_way ? ", two-way" : ", one-way"))
+            << '\n';
+    }
   }
 
 
@@ -317,17 +335,55 @@ namespace ImmersedGrains
   {
     unsigned int fluid_iterations = 0;
     double       new_time         = time + dt;
-    if (fluid)
+    if (coupling)
+    {
+      const GrainStepReport report =
+        solve_coupled_time_step(dt, fluid_iterations);
+      record_grain_step(report);
+    }
+    else if (fluid)
     {
       const auto stats = fluid->solve_time_step(new_time, dt);
       fluid_iterations = stats.linear_iterations;
       statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
       statistics.set("fluid_residual", stats.final_residual);
     }
-    if (grains)
+    if (grains && !coupling)
+      record_grain_step(grains->advance(dt));
+    time = new_time;
+    postprocess(dt, fluid_iterations);
+  }
+
+
+  template <int dim>
+  GrainStepReport
+  Simulation<dim>::solve_coupled_time_step(const double  dt,
+                                           unsigned int &fluid_iterations)
+  {
+    // The seed's step: grains -> solid fraction -> fluid with implicit drag
+    // -> interaction force -> grain velocities with implicit drag ->
+    // contacts with the drag-augmented mass -> positions.
+    grains->gather();
+    coupling->project(*grains);
+    coupling->prepare_fluid_drag(*grains, *fluid, dt);
+    const auto stats = fluid->solve_time_step(time + dt, dt);
+    fluid_iterations = stats.linear_iterations;
+    statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
+    statistics.set("fluid_residual", stats.final_residual);
+    coupling->set_grain_forces(*grains, *fluid, dt);
+    grains->compute_free_velocities(dt);
+    GrainStepReport report = grains->resolve_contacts(dt);
+    report.removed         = grains->move_and_scatter(dt);
+    return report;
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::record_grain_step(const GrainStepReport &report)
+  {
     {
-      const GrainStepReport report = grains->advance(dt);
-      const auto           &c      = report.contacts;
+      const auto &c = report.contacts;
       statistics.set("max_overlap", c.max_overlap);
       statistics.set("contacts", c.n_active);
       statistics.set("contact_iterations", c.iterations);
@@ -340,8 +396,6 @@ namespace ImmersedGrains
               << "after " << c.iterations << " sweeps, residual "
               << c.residual << ", overlap " << c.max_overlap << " m\n";
     }
-    time = new_time;
-    postprocess(dt, fluid_iterations);
   }
 
 
@@ -364,7 +418,8 @@ namespace ImmersedGrains
       const double fluid_volume = fluid->integrate_fluid_fraction();
       statistics.set("dofs", fluid->n_dofs());
       statistics.set("fluid_volume", fluid_volume);
-      statistics.set("solid_volume", volume - fluid_volume);
+      statistics.set("solid_volume",
+                     coupling ? coupling->solid_volume() : volume - fluid_volume);
     }
     if (grains)
       set_grain_statistics();

@@ -6,6 +6,7 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/tria.h>
 
+#include <immersed_grains/coupling/coupling.h>
 #include <immersed_grains/fluid/fluid_parameters.h>
 #include <immersed_grains/grains/grain_parameters.h>
 #include <immersed_grains/grains/placement.h>
@@ -25,6 +26,7 @@ namespace ImmersedGrains
   class FieldOutput;
   template <int dim>
   class Grains;
+  struct GrainStepReport;
   template <int dim>
   class ParticleOutput;
 
@@ -58,6 +60,10 @@ namespace ImmersedGrains
     next_time_step() const;
     void
     solve_time_step(double dt);
+    GrainStepReport
+    solve_coupled_time_step(double dt, unsigned int &fluid_iterations);
+    void
+    record_grain_step(const GrainStepReport &report);
     void
     postprocess(double dt, unsigned int fluid_iterations);
     void
@@ -84,6 +90,7 @@ namespace ImmersedGrains
     Geometry<dim>        geometry;
     FluidParameters<dim> fluid_parameters;
     GrainParameters<dim> grain_parameters;
+    typename Coupling<dim>::Parameters coupling_parameters;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
 
@@ -97,6 +104,7 @@ namespace ImmersedGrains
     std::unique_ptr<FieldOutput<dim>>                 field_output;
     std::unique_ptr<Grains<dim>>                      grains;
     std::unique_ptr<ParticleOutput<dim>>              particle_output;
+    std::unique_ptr<Coupling<dim>>                    coupling;
 
     double       time = 0;
     unsigned int step = 0;

@@ -70,6 +70,9 @@ namespace ImmersedGrains
     dealii::Vector<double>     cell_rhs(dofs_per_cell);
     dealii::Vector<double>     cell_reaction(dofs_per_cell);
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
+    std::vector<PointDrag<dim>>                  drags;
+    std::vector<double>                          point_shape(dofs_per_cell);
+    std::vector<double>                          local_solution(dofs_per_cell);
 
     std::vector<dealii::Tensor<1, dim>> u(n_q), u_old(n_q), u_older(n_q);
     std::vector<dealii::Tensor<2, dim>> grad_u(n_q);
@@ -97,6 +100,12 @@ namespace ImmersedGrains
       if (!cell->is_locally_owned())
         continue;
       fe_values.reinit(cell);
+      if (point_drag_source)
+      {
+        cell->get_dof_indices(dof_indices);
+        for (unsigned int k = 0; k < dofs_per_cell; ++k)
+          local_solution[k] = solution(dof_indices[k]);
+      }
       cell_matrix = 0;
       cell_rhs    = 0;
       if (assemble_preconditioner_matrices)
@@ -197,6 +206,44 @@ namespace ImmersedGrains
             else
               cell_reaction(i) +=
                 (mass + beta) * phi_u[i][component] * phi_u[i][component] * JxW;
+          }
+        }
+      }
+
+      // Grains in this cell: beta_i (u(x_i) - v_i) . N_k(x_i), implicit.
+      if (point_drag_source)
+      {
+        drags.clear();
+        point_drag_source->point_drags(cell, drags);
+        for (const auto &drag : drags)
+        {
+          for (unsigned int k = 0; k < dofs_per_cell; ++k)
+          {
+            const unsigned int c = fe.system_to_component_index(k).first;
+            point_shape[k] =
+              c < dim ? fe.shape_value(k, drag.reference_location) : 0.0;
+          }
+          dealii::Tensor<1, dim> u_at_grain;
+          for (unsigned int k = 0; k < dofs_per_cell; ++k)
+            if (point_shape[k] != 0)
+              u_at_grain[fe.system_to_component_index(k).first] +=
+                local_solution[k] * point_shape[k];
+          const dealii::Tensor<1, dim> slip = u_at_grain - drag.velocity;
+          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+          {
+            if (point_shape[i] == 0)
+              continue;
+            const unsigned int ci = fe.system_to_component_index(i).first;
+            cell_rhs(i) -= drag.beta * slip[ci] * point_shape[i];
+            for (unsigned int j = 0; j < dofs_per_cell; ++j)
+              if (point_shape[j] != 0 &&
+                  fe.system_to_component_index(j).first == ci)
+                cell_matrix(i, j) += drag.beta * point_shape[i] * point_shape[j];
+            if (assemble_preconditioner_matrices)
+            {
+              cell_reaction(i) += drag.beta * point_shape[i] * point_shape[i];
+              max_beta = std::max(max_beta, drag.beta);
+            }
           }
         }
       }

@@ -128,6 +128,49 @@ namespace ImmersedGrains
 
   template <int dim>
   void
+  FluidSolver<dim>::set_point_drag_source(
+    std::shared_ptr<const PointDragSource<dim>> source)
+  {
+    point_drag_source = source;
+  }
+
+
+  template <int dim>
+  std::vector<typename FluidSolver<dim>::PointValues>
+  FluidSolver<dim>::point_values(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &tria_cell,
+    const std::vector<dealii::Point<dim>> &reference_locations) const
+  {
+    const typename dealii::DoFHandler<dim>::active_cell_iterator cell(
+      &triangulation, tria_cell->level(), tria_cell->index(), &dof_handler);
+    std::vector<dealii::types::global_dof_index> indices(fe.n_dofs_per_cell());
+    cell->get_dof_indices(indices);
+    const dealii::Quadrature<dim> points(reference_locations);
+    dealii::FEValues<dim>         fe_values(mapping,
+                                    fe,
+                                    points,
+                                    dealii::update_values |
+                                      dealii::update_gradients);
+    fe_values.reinit(cell);
+    std::vector<PointValues> values(reference_locations.size());
+    for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+    {
+      const double       coefficient = solution(indices[i]);
+      const unsigned int component   = fe.system_to_component_index(i).first;
+      for (unsigned int q = 0; q < values.size(); ++q)
+        if (component < dim)
+          values[q].velocity[component] +=
+            coefficient * fe_values.shape_value(i, q);
+        else
+          values[q].pressure_gradient +=
+            coefficient * fe_values.shape_grad(i, q);
+    }
+    return values;
+  }
+
+
+  template <int dim>
+  void
   FluidSolver<dim>::set_forcing(std::shared_ptr<dealii::Function<dim>> f)
   {
     forcing = f;

@@ -75,11 +75,18 @@ namespace ImmersedGrains
   void
   Grains<dim>::update_partition()
   {
-    const std::function<bool(
-      const typename dealii::Triangulation<dim>::active_cell_iterator &)>
-      owned = [](const auto &cell) { return cell->is_locally_owned(); };
-    const auto local = dealii::GridTools::compute_mesh_predicate_bounding_box<
-      dealii::Triangulation<dim>>(triangulation, owned, 1, true, 8);
+    // One box around this rank's cells (compute_mesh_predicate_bounding_box
+    // of deal.II 9.4 crashed on our meshes): coarser than a union of boxes,
+    // so possibly more ghosts, never fewer.
+    std::vector<dealii::BoundingBox<dim>> local;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        if (local.empty())
+          local.push_back(cell->bounding_box());
+        else
+          local[0].merge_with(cell->bounding_box());
+      }
     rank_boxes = dealii::Utilities::MPI::all_gather(comm, local);
     if (contacts)
       contacts->set_partition(rank_boxes);
@@ -92,23 +99,30 @@ namespace ImmersedGrains
   {
     dealii::TimerOutput::Scope scope(timer, "grains: setup");
     // Rank 0 hands every grain in; insert_global_particles sends each to
-    // the rank owning its cell, with the seed's index as its id.
-    std::vector<dealii::Point<dim>>             positions;
-    std::vector<std::vector<double>>            props;
-    std::vector<dealii::types::particle_index>  ids;
+    // the rank owning its cell and numbers them in rank 0's order, so that
+    // grain k gets id k. Properties are set afterwards from the seed list
+    // every rank holds: deal.II 9.4 hangs when only some ranks pass
+    // properties or ids to insert_global_particles.
+    std::vector<dealii::Point<dim>> positions;
     if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-      for (unsigned int k = 0; k < seeds.size(); ++k)
-      {
-        positions.push_back(seeds[k].position);
-        std::vector<double> p(properties.n_properties, 0.);
-        for (unsigned int d = 0; d < dim; ++d)
-          p[properties.velocity + d] = parameters.fixed ? 0 : seeds[k].velocity[d];
-        p[properties.radius] = seeds[k].radius;
-        props.push_back(p);
-        ids.push_back(k);
-      }
-    particles.insert_global_particles(positions, rank_boxes, props, ids);
+      for (const auto &seed : seeds)
+        positions.push_back(seed.position);
+    particles.insert_global_particles(positions, rank_boxes);
     particles.update_cached_numbers();
+    for (auto &p : particles)
+    {
+      const auto k = p.get_id();
+      AssertThrow(k < seeds.size() &&
+                    (p.get_location() - seeds[k].position).norm() <=
+                      1e-12 * (1 + seeds[k].position.norm()),
+                  dealii::ExcMessage("Grains: particle ids do not follow "
+                                     "the order of insertion."));
+      auto props = p.get_properties();
+      for (unsigned int d = 0; d < dim; ++d)
+        props[properties.velocity + d] =
+          parameters.fixed ? 0 : seeds[k].velocity[d];
+      props[properties.radius] = seeds[k].radius;
+    }
     AssertThrow(particles.n_global_particles() == seeds.size(),
                 dealii::ExcMessage(
                   "Grains: " +

@@ -64,6 +64,22 @@ namespace ImmersedGrains
     void
     set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields);
 
+    /** Grains' implicit drag as point terms (none by default). */
+    void
+    set_point_drag_source(std::shared_ptr<const PointDragSource<dim>> source);
+
+    /** Fluid velocity, its gradient and the pressure gradient at a point of
+     * a cell (for the interaction force on a grain). */
+    struct PointValues
+    {
+      dealii::Tensor<1, dim> velocity;
+      dealii::Tensor<1, dim> pressure_gradient;
+    };
+    std::vector<PointValues>
+    point_values(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &reference_locations) const;
+
     /** Replaces the forcing and boundary data (tests with exact solutions). */
     void
     set_forcing(std::shared_ptr<dealii::Function<dim>> forcing);
@@ -157,7 +173,8 @@ namespace ImmersedGrains
     VectorType system_rhs;       // owned: minus the residual
     VectorType newton_update;    // owned
 
-    std::shared_ptr<const MixtureFields<dim>> mixture_fields;
+    std::shared_ptr<const MixtureFields<dim>>   mixture_fields;
+    std::shared_ptr<const PointDragSource<dim>> point_drag_source;
     std::shared_ptr<dealii::Function<dim>>    forcing;
     std::shared_ptr<dealii::Function<dim>>    boundary_velocity;
 

@@ -86,6 +86,35 @@ namespace ImmersedGrains
     std::shared_ptr<dealii::Function<dim>> grain_velocity;
     std::shared_ptr<dealii::Function<dim>> mass_source;
   };
+
+  /**
+   * A grain's implicit drag on the fluid: the momentum equation gains
+   * beta_i (u(x_i) - v_i) delta(x - x_i), tested with the velocity shape
+   * functions at x_i (deal.II step-70's way of putting particles into an
+   * FE equation); beta_i u is assembled into the matrix, so the drag is
+   * implicit in the fluid as it is in the grains.
+   */
+  template <int dim>
+  struct PointDrag
+  {
+    dealii::Point<dim>     reference_location; // in its cell
+    double                 beta;               // [kg/s]
+    dealii::Tensor<1, dim> velocity;           // v_i
+  };
+
+
+  /** Lists the point drags of one cell (the grains in it). */
+  template <int dim>
+  class PointDragSource
+  {
+  public:
+    virtual ~PointDragSource() = default;
+
+    virtual void
+    point_drags(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      std::vector<PointDrag<dim>> &drags) const = 0;
+  };
 } // namespace ImmersedGrains
 
 #endif

@@ -41,7 +41,8 @@ namespace ImmersedGrains
    *    velocities, which gives exactly v + sum(impulses)/m: at convergence
    *    every contact law and the true equation of motion hold, as in serial;
    *  - convergence is decided on the maxima over all ranks, so all ranks
-   *    sweep the same number of times.
+   *    sweep the same number of times; ranks exchange after every few
+   *    local sweeps (sweeps_per_exchange), not after each.
    * On one rank this is the serial solver without any copying.
    */
   template <int dim>
@@ -92,6 +93,9 @@ namespace ImmersedGrains
     Contact::ContactSolver<dim> solver;
 
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
+
+    /// Local Gauss-Seidel sweeps between two glue exchanges (MPI only).
+    static constexpr unsigned int sweeps_per_exchange = 4;
 
     // This step's work: owned grains then ghosts.
     unsigned int                           n_owned = 0;

@@ -1,0 +1,125 @@
+#ifndef immersed_grains_coupling_coupling_h
+#define immersed_grains_coupling_coupling_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/distributed/tria.h>
+
+#include <immersed_grains/coupling/drag_law.h>
+#include <immersed_grains/coupling/solid_fraction.h>
+#include <immersed_grains/fluid/mixture_fields.h>
+
+#include <memory>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  class FluidSolver;
+  template <int dim>
+  class Grains;
+  template <int dim>
+  struct GrainParameters;
+
+  /**
+   * The two-way exchange between the averaged fluid and the grains (the
+   * seed's hybrid model, doc/theory.md section 3). Per time step:
+   *
+   *  1. project(): the solid fraction and the solid flux from the grains;
+   *  2. prepare_fluid_drag(dt): for each grain the interaction force with
+   *     the lagged pressure gradient, F_i = (m_i - rho V_i) g - V_i grad p,
+   *     the drag coefficient gamma_i = gamma(phi, |w|) of the chosen law
+   *     with the lagged slip, and the point drag the fluid sees once the
+   *     grain's implicit update is eliminated:
+   *       beta_i = gamma_i m_i / (m_i + dt gamma_i),  v~_i = v_i + dt F_i/m_i;
+   *  3. (the fluid solves with these point drags)
+   *  4. set_grain_forces(): the grains' hooks get -rho V_i g - V_i grad p,
+   *     gamma_i and the new u(x_i); their implicit update
+   *       v' = (m v + dt (m g + F + gamma u)) / (m + dt gamma)
+   *     then exchanges exactly the momentum the fluid received.
+   *
+   * With Two-way = false the fluid sees neither the solid fraction nor the
+   * drag (one-way coupling); with Tracers = true the grains take the fluid
+   * velocity and nothing else.
+   */
+  template <int dim>
+  class Coupling : public PointDragSource<dim>
+  {
+  public:
+    struct Parameters
+    {
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
+
+      std::string                               drag_law = "Dallavalle-Wen-Yu";
+      bool                                      two_way  = true;
+      bool                                      tracers  = false;
+      typename SolidFraction<dim>::Parameters   projection;
+    };
+
+    Coupling(const Parameters                                        &parameters,
+             const GrainParameters<dim>                              &grain_parameters,
+             const Geometry<dim>                                     &geometry,
+             const dealii::parallel::distributed::Triangulation<dim> &tria,
+             double                                                   fluid_density,
+             double                                                   fluid_viscosity,
+             dealii::TimerOutput                                     &timer);
+
+    /** After every mesh change. */
+    void
+    setup();
+
+    /** Connects the fluid to the projected fields and the point drags. */
+    void
+    attach(FluidSolver<dim> &fluid) const;
+
+    void
+    project(const Grains<dim> &grains);
+
+    void
+    prepare_fluid_drag(const Grains<dim> &grains, const FluidSolver<dim> &fluid, double dt);
+
+    /** Call after Grains::gather(), before compute_free_velocities(). */
+    void
+    set_grain_forces(Grains<dim> &grains, const FluidSolver<dim> &fluid, double dt);
+
+    void
+    point_drags(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      std::vector<PointDrag<dim>> &drags) const override;
+
+    /** Integral of the projected solid fraction. */
+    double
+    solid_volume() const;
+
+    /** Largest particle Reynolds number of the last step (global). */
+    double
+    max_reynolds() const;
+
+    const SolidFraction<dim> &
+    solid_fraction() const;
+
+  private:
+    const Parameters                                        &parameters;
+    const GrainParameters<dim>                              &grain_parameters;
+    const dealii::parallel::distributed::Triangulation<dim> &triangulation;
+    const double                                             density;
+    const double                                             viscosity;
+    dealii::TimerOutput                                     &timer;
+
+    std::shared_ptr<SolidFraction<dim>> projection;
+    std::unique_ptr<DragLaw>            drag_law;
+
+    // Per grain, in the ParticleHandler's iteration order (Grains' arrays).
+    std::vector<dealii::Tensor<1, dim>> lagged_force;  // without m g
+    std::vector<double>                 gamma;
+    // Per active cell: the point drags of its grains.
+    std::vector<std::vector<PointDrag<dim>>> cell_drags;
+
+    double reynolds_max = 0;
+  };
+} // namespace ImmersedGrains
+
+#endif

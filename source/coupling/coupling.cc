@@ -1,0 +1,301 @@
+#include <deal.II/base/mpi.h>
+
+#include <immersed_grains/coupling/coupling.h>
+#include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/grains/grains.h>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  void
+  Coupling<dim>::Parameters::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii::Patterns;
+    prm.enter_subsection("Coupling");
+    {
+      std::string documentation =
+        "Drag closure D = gamma(phi, |w|) w on each grain (w = v - u_f):";
+      for (const auto &[name, description] : DragLaw::descriptions())
+        documentation += " " + name + " (" + description + ");";
+      prm.declare_entry("Drag law",
+                        "Dallavalle-Wen-Yu",
+                        Selection(DragLaw::names()),
+                        documentation);
+      prm.declare_entry("Two-way",
+                        "true",
+                        Bool(),
+                        "The fluid feels the grains (solid fraction and drag "
+                        "reaction); false: one-way coupling, the grains feel "
+                        "the fluid only.");
+      prm.declare_entry("Tracers",
+                        "false",
+                        Bool(),
+                        "Grains take the fluid velocity at their centre and "
+                        "feel nothing else (implies Two-way = false).");
+      SolidFraction<dim>::Parameters::declare_parameters(prm);
+    }
+    prm.leave_subsection();
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::Parameters::parse_parameters(dealii::ParameterHandler &prm,
+                                              const std::string        &file)
+  {
+    prm.enter_subsection("Coupling");
+    {
+      drag_law = prm.get("Drag law");
+      tracers  = prm.get_bool("Tracers");
+      two_way  = prm.get_bool("Two-way") && !tracers;
+      projection.parse_parameters(prm, file);
+    }
+    prm.leave_subsection();
+  }
+
+
+  template <int dim>
+  Coupling<dim>::Coupling(
+    const Parameters                                        &parameters,
+    const GrainParameters<dim>                              &grain_parameters,
+    const Geometry<dim>                                     &geometry,
+    const dealii::parallel::distributed::Triangulation<dim> &tria,
+    const double                                             fluid_density,
+    const double                                             fluid_viscosity,
+    dealii::TimerOutput                                     &timer)
+    : parameters(parameters)
+    , grain_parameters(grain_parameters)
+    , triangulation(tria)
+    , density(fluid_density)
+    , viscosity(fluid_viscosity)
+    , timer(timer)
+    , projection(std::make_shared<SolidFraction<dim>>(parameters.projection,
+                                                      geometry,
+                                                      tria))
+    , drag_law(DragLaw::create(parameters.drag_law))
+  {}
+
+
+  template <int dim>
+  void
+  Coupling<dim>::setup()
+  {
+    projection->setup();
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::attach(FluidSolver<dim> &fluid) const
+  {
+    if (!parameters.two_way)
+      return;
+    fluid.set_mixture_fields(projection);
+    // The simulation owns both; the fluid only borrows this object.
+    fluid.set_point_drag_source(std::shared_ptr<const PointDragSource<dim>>(
+      this, [](const PointDragSource<dim> *) {}));
+  }
+
+
+  namespace
+  {
+    // Calls @p f(cell, first, end) for each run of consecutive particles in
+    // the same cell; the ParticleHandler iterates cell by cell, in the order
+    // in which Grains gathered its arrays.
+    template <int dim, typename F>
+    void
+    for_each_cell_batch(const dealii::Particles::ParticleHandler<dim> &particles,
+                        std::vector<dealii::Point<dim>>               &references,
+                        F                                            &&f)
+    {
+      unsigned int index = 0;
+      auto         it    = particles.begin();
+      while (it != particles.end())
+      {
+        const auto   cell  = it->get_surrounding_cell();
+        const unsigned int first = index;
+        references.clear();
+        while (it != particles.end() && it->get_surrounding_cell() == cell)
+        {
+          references.push_back(it->get_reference_location());
+          ++it;
+          ++index;
+        }
+        f(cell, first, index);
+      }
+    }
+
+    template <int dim>
+    double
+    projected_area(const double r)
+    {
+      return dim == 2 ? 2 * r : M_PI * r * r;
+    }
+  } // namespace
+
+
+  template <int dim>
+  void
+  Coupling<dim>::project(const Grains<dim> &grains)
+  {
+    dealii::TimerOutput::Scope scope(timer, "coupling: solid fraction");
+    const auto &particles = grains.particle_handler();
+    const auto &layout    = grains.layout();
+    projection->project([&](const auto &cell, std::vector<GrainSample<dim>> &samples) {
+      for (const auto &p : particles.particles_in_cell(cell))
+      {
+        const auto     props = p.get_properties();
+        GrainSample<dim> s;
+        s.reference_location = p.get_reference_location();
+        s.volume             = grain_volume<dim>(props[layout.radius]);
+        for (unsigned int d = 0; d < dim; ++d)
+          s.velocity[d] = grain_parameters.fixed ? 0.0 : props[layout.velocity + d];
+        samples.push_back(s);
+      }
+    });
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::prepare_fluid_drag(const Grains<dim>      &grains,
+                                    const FluidSolver<dim> &fluid,
+                                    const double            dt)
+  {
+    dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
+    auto       &arrays = const_cast<Grains<dim> &>(grains).step_arrays();
+    const auto &c      = arrays.contact;
+    const unsigned int n = c.velocity.size();
+    lagged_force.assign(n, dealii::Tensor<1, dim>());
+    gamma.assign(n, 0.0);
+    cell_drags.assign(triangulation.n_active_cells(), {});
+    reynolds_max = 0;
+
+    const dealii::Tensor<1, dim> g = grain_parameters.gravity;
+    std::vector<dealii::Point<dim>> references;
+    MixtureValues<dim>              mixture;
+    for_each_cell_batch<dim>(
+      grains.particle_handler(),
+      references,
+      [&](const auto &cell, const unsigned int first, const unsigned int end) {
+        const auto fluid_values = fluid.point_values(cell, references);
+        projection->evaluate(cell, references, references, 0, mixture);
+        for (unsigned int i = first; i < end; ++i)
+        {
+          const unsigned int k = i - first;
+          const double       r = c.radius[i], m = arrays.mass[i];
+          const double       V = grain_volume<dim>(r);
+          // The seed's interaction force without drag: gravity minus
+          // buoyancy (m g comes from Grains) and the dynamic pressure.
+          lagged_force[i] =
+            -density * V * g - V * fluid_values[k].pressure_gradient;
+          const dealii::Tensor<1, dim> slip =
+            c.velocity[i] - fluid_values[k].velocity;
+          const DragInput in{r,
+                             projected_area<dim>(r),
+                             V,
+                             mixture.fluid_fraction[k],
+                             slip.norm(),
+                             density,
+                             viscosity};
+          gamma[i]     = drag_law->coefficient(in);
+          reynolds_max = std::max(reynolds_max, DragLaw::reynolds(in));
+
+          // The drag the fluid sees after eliminating the grain's implicit
+          // update (a fixed grain is infinitely heavy: full gamma, v = 0).
+          PointDrag<dim> drag;
+          drag.reference_location = references[k];
+          if (grain_parameters.fixed)
+          {
+            drag.beta     = gamma[i];
+            drag.velocity = 0;
+          }
+          else
+          {
+            drag.beta     = gamma[i] * m / (m + dt * gamma[i]);
+            drag.velocity = c.velocity[i] + dt / m * (m * g + lagged_force[i]);
+          }
+          cell_drags[cell->active_cell_index()].push_back(drag);
+        }
+      });
+    reynolds_max =
+      dealii::Utilities::MPI::max(reynolds_max, triangulation.get_communicator());
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::set_grain_forces(Grains<dim>            &grains,
+                                  const FluidSolver<dim> &fluid,
+                                  const double            dt)
+  {
+    dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
+    auto              &arrays = grains.step_arrays();
+    const unsigned int n      = arrays.contact.velocity.size();
+    arrays.external_force.resize(n);
+    arrays.drag_coefficient.resize(n);
+    arrays.drag_velocity.resize(n);
+
+    std::vector<dealii::Point<dim>> references;
+    for_each_cell_batch<dim>(
+      grains.particle_handler(),
+      references,
+      [&](const auto &cell, const unsigned int first, const unsigned int end) {
+        const auto fluid_values = fluid.point_values(cell, references);
+        for (unsigned int i = first; i < end; ++i)
+        {
+          const auto &u = fluid_values[i - first].velocity;
+          arrays.drag_velocity[i] = u;
+          if (parameters.tracers)
+          {
+            // The limit gamma -> infinity of the implicit update: v' = u to
+            // twelve digits, gravity cancelled.
+            arrays.external_force[i]   = -arrays.mass[i] * grain_parameters.gravity;
+            arrays.drag_coefficient[i] = 1e12 * arrays.mass[i] / dt;
+            continue;
+          }
+          arrays.external_force[i]   = lagged_force[i];
+          arrays.drag_coefficient[i] = gamma[i];
+        }
+      });
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::point_drags(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    std::vector<PointDrag<dim>> &drags) const
+  {
+    if (cell->active_cell_index() < cell_drags.size())
+      drags = cell_drags[cell->active_cell_index()];
+  }
+
+
+  template <int dim>
+  double
+  Coupling<dim>::solid_volume() const
+  {
+    return projection->integral();
+  }
+
+
+  template <int dim>
+  double
+  Coupling<dim>::max_reynolds() const
+  {
+    return reynolds_max;
+  }
+
+
+  template <int dim>
+  const SolidFraction<dim> &
+  Coupling<dim>::solid_fraction() const
+  {
+    return *projection;
+  }
+
+
+  template class Coupling<2>;
+  template class Coupling<3>;
+} // namespace ImmersedGrains
