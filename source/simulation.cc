@@ -49,6 +49,8 @@ namespace ImmersedGrains
                                "fluid_volume",
                                "packing_fraction",
                                "grains_removed",
+                               "solid_volume_error",
+                               "max_reynolds",
                                "contact_residual",
                                "contact_converged",
                                "max_contact_force",
@@ -133,7 +135,10 @@ namespace ImmersedGrains
       , parameter_file(file)
       , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       , statistics(statistics_columns(dim))
-      , triangulation(comm, dealii::Triangulation<dim>::maximum_smoothing)
+      , triangulation(comm,
+                      typename dealii::Triangulation<dim>::MeshSmoothing(
+                        dealii::Triangulation<dim>::smoothing_on_refinement |
+                        dealii::Triangulation<dim>::smoothing_on_coarsening))
       , wall_start(now())
   {
     const InputLocation top{file, ""};
@@ -393,8 +398,8 @@ namespace ImmersedGrains
       statistics.set("alert_distance", report.alert_distance);
       if (!c.converged && grain_parameters.contacts_enabled)
         pcout << "  warning: step " << step << ": the contact solver stopped "
-              << "after " << c.iterations << " sweeps, residual "
-              << c.residual << ", overlap " << c.max_overlap << " m\n";
+              << "after " << c.iterations << " sweeps, residual " << c.residual
+              << ", overlap " << c.max_overlap << " m\n";
     }
   }
 
@@ -419,7 +424,8 @@ namespace ImmersedGrains
       statistics.set("dofs", fluid->n_dofs());
       statistics.set("fluid_volume", fluid_volume);
       statistics.set("solid_volume",
-                     coupling ? coupling->solid_volume() : volume - fluid_volume);
+                     coupling ? coupling->solid_volume() :
+                                volume - fluid_volume);
     }
     if (grains)
       set_grain_statistics();
@@ -446,11 +452,20 @@ namespace ImmersedGrains
   void
   Simulation<dim>::set_grain_statistics()
   {
-    const GrainStatistics<dim> s = grains->compute_statistics();
+    const GrainStatistics<dim> s      = grains->compute_statistics();
     const char                *axes[] = {"x", "y", "z"};
     statistics.set("particles", s.n_grains);
     if (!fluid)
       statistics.set("solid_volume", s.solid_volume);
+    if (coupling && s.solid_volume > 0)
+    {
+      // Conservation of the projection: what the fluid sees against what
+      // the grains are.
+      statistics.set("solid_volume_error",
+                     std::abs(statistics.get("solid_volume") - s.solid_volume) /
+                       s.solid_volume);
+      statistics.set("max_reynolds", coupling->max_reynolds());
+    }
     for (unsigned int d = 0; d < dim; ++d)
     {
       statistics.set(std::string("centroid_") + axes[d], s.centroid[d]);

@@ -76,8 +76,8 @@ namespace ImmersedGrains
     MPI_Comm    comm;
     std::string parameter_file;
     std::string output_directory;
-    double      end_time  = 1;
-    double      time_step = 1;
+    double      end_time           = 1;
+    double      time_step          = 1;
     bool        adaptive_time_step = false;
 
     unsigned int             write_fields_every = 0;
@@ -87,9 +87,9 @@ namespace ImmersedGrains
     unsigned int             test_every = 1;
     std::vector<TestCheck>   test_checks;
 
-    Geometry<dim>        geometry;
-    FluidParameters<dim> fluid_parameters;
-    GrainParameters<dim> grain_parameters;
+    Geometry<dim>                      geometry;
+    FluidParameters<dim>               fluid_parameters;
+    GrainParameters<dim>               grain_parameters;
     typename Coupling<dim>::Parameters coupling_parameters;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;

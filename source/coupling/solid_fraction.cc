@@ -315,7 +315,6 @@ namespace ImmersedGrains
             values.fluid_fraction_gradient[q] = -evaluator.get_gradient(q);
           }
         values.drag_coefficient[q]      = 0;
-        values.solid_flux_divergence[q] = 0;
         values.mass_source[q]           = 0;
       }
     std::vector<double> solid(n_points);
@@ -326,7 +325,7 @@ namespace ImmersedGrains
         evaluate_field(flux[d]);
         for (unsigned int q = 0; q < n_points; ++q)
           {
-            values.solid_flux_divergence[q] += evaluator.get_gradient(q)[d];
+            values.solid_flux[q][d] = evaluator.get_value(q);
             values.grain_velocity[q][d] =
               solid[q] > 1e-12 ? evaluator.get_value(q) / solid[q] : 0.0;
           }

@@ -17,8 +17,10 @@ namespace ImmersedGrains
    *       + (phi rho (grad u) u, v) + (phi mu grad u, grad v)
    *       - (p, div(phi v)) + (beta (u - u_p), v) - (f, v)
    *       + <phi p_open, v.n>_open
-   *   R_p = -(q, div(phi u) + div((1 - phi) u_p) - g),
+   *   R_p = -(q, div(phi u) - g) + (grad q, s) - <q, s.n>_{open, velocity},
    *
+   * s = (1 - phi) u_p the solid volume flux (integrated by parts: walls
+   * let no grain through),
    * with div(phi v) = phi div v + grad phi . v, so that the pressure and the
    * continuity blocks are transposes of each other.
    */
@@ -84,6 +86,7 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<2, dim>> grad_phi_u(dofs_per_cell);
     std::vector<double>                 div_phi_u(dofs_per_cell);
     std::vector<double>                 phi_p(dofs_per_cell);
+    std::vector<dealii::Tensor<1, dim>> grad_phi_p(dofs_per_cell);
 
     const double rho = parameters.density, mu = parameters.viscosity;
     const double inv_dt =
@@ -143,6 +146,7 @@ namespace ImmersedGrains
           grad_phi_u[k] = fe_values[velocities].gradient(k, q);
           div_phi_u[k]  = fe_values[velocities].divergence(k, q);
           phi_p[k]      = fe_values[pressure].value(k, q);
+        grad_phi_p[k] = fe_values[pressure].gradient(k, q);
         }
 
         // Strong-form pieces of the residual at this point.
@@ -155,16 +159,21 @@ namespace ImmersedGrains
         for (unsigned int d = 0; d < dim; ++d)
           momentum[d] -= f[q](d);
         const dealii::Tensor<2, dim> viscous = phi * mu * grad_u[q];
-        const double                 continuity =
-          phi * dealii::trace(grad_u[q]) + grad_phi * u[q] +
-          mixture.solid_flux_divergence[q] - mixture.mass_source[q];
+        // The solid flux enters integrated by parts, (grad q, s): its
+        // normal component is then zero on walls, where grains cannot pass,
+        // and the continuity equation stays compatible with a pressure
+        // fixed only up to a constant.
+        const double continuity = phi * dealii::trace(grad_u[q]) +
+                                  grad_phi * u[q] - mixture.mass_source[q];
+        const dealii::Tensor<1, dim> &solid_flux = mixture.solid_flux[q];
 
         for (unsigned int i = 0; i < dofs_per_cell; ++i)
         {
           const double div_phi_v = phi * div_phi_u[i] + grad_phi * phi_u[i];
           cell_rhs(i) -= (momentum * phi_u[i] +
                           dealii::scalar_product(viscous, grad_phi_u[i]) -
-                          p[q] * div_phi_v - phi_p[i] * continuity) *
+                          p[q] * div_phi_v - phi_p[i] * continuity +
+                          grad_phi_p[i] * solid_flux) *
                          JxW;
 
           for (unsigned int j = 0; j < dofs_per_cell; ++j)
@@ -248,12 +257,15 @@ namespace ImmersedGrains
         }
       }
 
-      // Weakly imposed pressure on open faces.
+      // Open faces: the weakly imposed pressure. Open and velocity faces:
+      // the solid flux that crosses them, -<q, s.n> (walls let none pass).
       for (const unsigned int face_no : cell->face_indices())
       {
         const auto face = cell->face(face_no);
-        if (!face->at_boundary() ||
-            geometry.boundary_types[face->boundary_id()] != BoundaryType::open)
+        if (!face->at_boundary())
+          continue;
+        const BoundaryType type = geometry.boundary_types[face->boundary_id()];
+        if (type != BoundaryType::open && type != BoundaryType::velocity)
           continue;
         fe_face_values.reinit(cell, face_no);
         MixtureValues<dim> face_mixture;
@@ -264,13 +276,20 @@ namespace ImmersedGrains
                                  face_mixture);
         for (unsigned int q = 0; q < face_quadrature.size(); ++q)
         {
-          const double p_open = parameters.open_boundary_pressure->value(
-            fe_face_values.quadrature_point(q));
-          const double weight =
-            face_mixture.fluid_fraction[q] * p_open * fe_face_values.JxW(q);
+          const auto  &n       = fe_face_values.normal_vector(q);
+          const double JxW     = fe_face_values.JxW(q);
+          const double outflux = face_mixture.solid_flux[q] * n;
+          const double p_open =
+            type == BoundaryType::open ?
+              parameters.open_boundary_pressure->value(
+                fe_face_values.quadrature_point(q)) :
+              0.0;
           for (unsigned int i = 0; i < dofs_per_cell; ++i)
-            cell_rhs(i) -= weight * (fe_face_values[velocities].value(i, q) *
-                                     fe_face_values.normal_vector(q));
+            cell_rhs(i) -=
+              (face_mixture.fluid_fraction[q] * p_open *
+                 (fe_face_values[velocities].value(i, q) * n) -
+               fe_face_values[pressure].value(i, q) * outflux) *
+              JxW;
         }
       }
 

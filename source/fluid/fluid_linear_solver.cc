@@ -3,6 +3,7 @@
 #include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
 #include <deal.II/lac/trilinos_vector.h>
 
 #include <immersed_grains/fluid/block_preconditioner.h>
@@ -51,22 +52,53 @@ namespace ImmersedGrains
         inverse_diagonal[i]   = 1.0 / (reaction + 1e-2 * rest);
       }
       inverse_diagonal.compress(dealii::VectorOperation::insert);
-      system_matrix.block(1, 0).mmult(schur_diagonal_matrix,
+      dealii::TrilinosWrappers::SparseMatrix product;
+      system_matrix.block(1, 0).mmult(product,
                                       system_matrix.block(0, 1),
                                       inverse_diagonal);
-      if (pressure_has_null_space())
+
+      // Pressure DoFs constrained by hanging nodes or periodicity have
+      // empty rows in the product; AMG needs a diagonal everywhere. So the
+      // matrix handed on has the product's pattern plus the diagonal (built
+      // once per mesh), empty rows get the mean diagonal, and without an
+      // open face a shift of a millionth of that mean removes the constant
+      // null space for AMG's coarse solve.
+      if (schur_diagonal_matrix.m() != product.m())
       {
-        // Constant pressures are in its kernel: a shift of a millionth
-        // of the mean diagonal makes AMG's coarse solve well posed.
-        double mean = 0;
+        dealii::TrilinosWrappers::SparsityPattern pattern(
+          owned_partitioning[1], owned_partitioning[1], mpi_communicator);
         for (const auto i : owned_partitioning[1])
-          mean += schur_diagonal_matrix.diag_element(i);
-        mean = dealii::Utilities::MPI::sum(mean, mpi_communicator) /
-               system_matrix.block(1, 1).m();
-        for (const auto i : owned_partitioning[1])
-          schur_diagonal_matrix.add(i, i, 1e-6 * mean);
-        schur_diagonal_matrix.compress(dealii::VectorOperation::add);
+        {
+          pattern.add(i, i);
+          for (auto entry = product.begin(i); entry != product.end(i); ++entry)
+            pattern.add(i, entry->column());
+        }
+        pattern.compress();
+        schur_diagonal_matrix.reinit(pattern);
       }
+      schur_diagonal_matrix = 0;
+      double       mean = 0;
+      unsigned int n    = 0;
+      for (const auto i : owned_partitioning[1])
+        for (auto entry = product.begin(i); entry != product.end(i); ++entry)
+        {
+          schur_diagonal_matrix.set(i, entry->column(), entry->value());
+          if (entry->column() == i && entry->value() != 0)
+          {
+            mean += entry->value();
+            ++n;
+          }
+        }
+      schur_diagonal_matrix.compress(dealii::VectorOperation::insert);
+      mean = dealii::Utilities::MPI::sum(mean, mpi_communicator) /
+             std::max(1u, dealii::Utilities::MPI::sum(n, mpi_communicator));
+      const double shift = pressure_has_null_space() ? 1e-6 * mean : 0.0;
+      for (const auto i : owned_partitioning[1])
+      {
+        const double d = schur_diagonal_matrix.diag_element(i);
+        schur_diagonal_matrix.set(i, i, d == 0 ? mean : d + shift);
+      }
+      schur_diagonal_matrix.compress(dealii::VectorOperation::insert);
     }
     preconditioner = std::make_unique<BlockSchurPreconditioner>(
       system_matrix,

@@ -262,6 +262,7 @@ namespace ImmersedGrains
     reaction_diagonal.reinit(owned_partitioning, mpi_communicator);
     newton_update.reinit(owned_partitioning, mpi_communicator);
     preconditioner.reset();
+    schur_diagonal_matrix.clear();
   }
 
 

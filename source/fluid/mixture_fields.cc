@@ -10,7 +10,7 @@ namespace ImmersedGrains
     fluid_fraction_gradient.resize(n);
     drag_coefficient.resize(n);
     grain_velocity.resize(n);
-    solid_flux_divergence.resize(n);
+    solid_flux.resize(n);
     mass_source.resize(n);
   }
 
@@ -55,15 +55,9 @@ namespace ImmersedGrains
       values.fluid_fraction_gradient[q] = grad_phi;
       values.drag_coefficient[q]        = drag_coefficient->value(x);
 
-      // div((1 - phi) u_p) = (1 - phi) div u_p - grad(phi) . u_p
-      double div_up = 0;
       for (unsigned int d = 0; d < dim; ++d)
-      {
         values.grain_velocity[q][d] = grain_velocity->value(x, d);
-        div_up += grain_velocity->gradient(x, d)[d];
-      }
-      values.solid_flux_divergence[q] =
-        (1 - phi) * div_up - grad_phi * values.grain_velocity[q];
+      values.solid_flux[q] = (1 - phi) * values.grain_velocity[q];
       values.mass_source[q] = mass_source ? mass_source->value(x) : 0.0;
     }
   }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace ImmersedGrains
 {
@@ -39,7 +40,7 @@ namespace ImmersedGrains
 
   template <int dim>
   DistributedContacts<dim>::DistributedContacts(
-    const Geometry<dim>               &geometry,
+    const Geometry<dim>              &geometry,
     const Contact::ContactParameters &parameters,
     MPI_Comm                          comm)
       : comm(comm)
@@ -80,16 +81,16 @@ namespace ImmersedGrains
       double d2 = 0;
       for (unsigned int d = 0; d < dim; ++d)
       {
-        const double lo = box.get_boundary_points().first[d];
-        const double hi = box.get_boundary_points().second[d];
-        const auto   gap = [&](const double y)
-        { return std::max({lo - y, y - hi, 0.}); };
+        const double lo  = box.get_boundary_points().first[d];
+        const double hi  = box.get_boundary_points().second[d];
+        const auto   gap = [&](const double y) {
+          return std::max({lo - y, y - hi, 0.});
+        };
         double g = gap(x[d]);
         if (geometry.is_periodic(d))
         {
-          const double L =
-            geometry.upper_corner[d] - geometry.lower_corner[d];
-          g = std::min({g, gap(x[d] - L), gap(x[d] + L)});
+          const double L = geometry.upper_corner[d] - geometry.lower_corner[d];
+          g              = std::min({g, gap(x[d] - L), gap(x[d] + L)});
         }
         d2 += g * g;
       }
@@ -105,8 +106,11 @@ namespace ImmersedGrains
                                             const double               reach)
   {
     constexpr unsigned int spin_dim = (dim == 2 ? 1 : 3);
-    const bool             start    = !g.start_velocity.empty();
-    const unsigned int     width =
+    // Decided together: a rank without grains has empty arrays but must
+    // read the same message layout.
+    const bool start =
+      dealii::Utilities::MPI::max(int(!g.start_velocity.empty()), comm) > 0;
+    const unsigned int width =
       2 + 2 * dim + (start ? dim : 0) + 1 + (friction ? 1 + spin_dim : 0) + 1;
 
     send_lists.clear();
@@ -168,10 +172,10 @@ namespace ImmersedGrains
         list.push_back(all_positions.size());
         ghost_owner.push_back(q);
         ids.push_back(static_cast<std::uint64_t>(b[0]));
-        const double     k = b[1];
-        dealii::Point<dim> x;
+        const double           k = b[1];
+        dealii::Point<dim>     x;
         dealii::Tensor<1, dim> v, v0;
-        unsigned int     c = 2;
+        unsigned int           c = 2;
         for (unsigned int d = 0; d < dim; ++d)
           x[d] = b[c++];
         for (unsigned int d = 0; d < dim; ++d)
@@ -209,8 +213,7 @@ namespace ImmersedGrains
     { return i < n_owned ? my_rank : ghost_owner[i - n_owned]; };
     pairs.erase(std::remove_if(pairs.begin(),
                                pairs.end(),
-                               [&](const Contact::GrainPair<dim> &p)
-                               {
+                               [&](const Contact::GrainPair<dim> &p) {
                                  return std::min(owner(p.first),
                                                  owner(p.second)) != my_rank;
                                }),
@@ -231,7 +234,7 @@ namespace ImmersedGrains
       return;
     constexpr unsigned int spin_dim = (dim == 2 ? 1 : 3);
     const unsigned int     width    = dim + (friction ? spin_dim : 0);
-    const auto pack = [&](const unsigned int i, double *b)
+    const auto             pack     = [&](const unsigned int i, double *b)
     {
       const auto v = solver.get_velocity(i);
       for (unsigned int d = 0; d < dim; ++d)
@@ -367,9 +370,9 @@ namespace ImmersedGrains
   template <int dim>
   Contact::SolverResult
   DistributedContacts<dim>::solve(const std::vector<dealii::Point<dim>> &x,
-                                  Contact::GrainArrays<dim> &g,
-                                  const double               dt,
-                                  const double               alert)
+                                  Contact::GrainArrays<dim>             &g,
+                                  const double                           dt,
+                                  const double                           alert)
   {
     n_owned   = x.size();
     time_step = dt;
@@ -398,7 +401,7 @@ namespace ImmersedGrains
     if (n_ranks > 1)
       keep_own_contacts();
 
-    const auto &prm = solver.get_parameters();
+    const auto           &prm = solver.get_parameters();
     Contact::SolverResult result;
     solver.setup(pairs, wall_contacts, walls.velocities(), g, dt);
     glue_copies();
@@ -413,14 +416,13 @@ namespace ImmersedGrains
       // sees what the last glue did to the copies, so a batch converges
       // only once gluing no longer disturbs the contacts.
       Contact::SweepResult s;
-      for (unsigned int q = 0;
-           q < (n_ranks > 1 ? sweeps_per_exchange : 1) &&
-           result.iterations < prm.max_iterations;
+      for (unsigned int q = 0; q < (n_ranks > 1 ? sweeps_per_exchange : 1) &&
+                               result.iterations < prm.max_iterations;
            ++q)
       {
         const Contact::SweepResult t = solver.sweep();
-        s.max_change  = std::max(s.max_change, t.max_change);
-        s.max_impulse = std::max(s.max_impulse, t.max_impulse);
+        s.max_change                 = std::max(s.max_change, t.max_change);
+        s.max_impulse                = std::max(s.max_impulse, t.max_impulse);
         ++result.iterations;
       }
       glue_copies();

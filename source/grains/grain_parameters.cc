@@ -213,11 +213,11 @@ namespace ImmersedGrains
       {
         const InputLocation place{file, "Grains/Placement"};
         const std::string   s = prm.get("Shape");
-        shape = (s == "ball" ? PlacementShape::ball :
-                 s == "box"  ? PlacementShape::box :
-                 s == "file" ? PlacementShape::file :
-                 s == "lattice" ? PlacementShape::lattice :
-                                  PlacementShape::list);
+        shape                 = (s == "ball"    ? PlacementShape::ball :
+                                 s == "box"     ? PlacementShape::box :
+                                 s == "file"    ? PlacementShape::file :
+                                 s == "lattice" ? PlacementShape::lattice :
+                                                  PlacementShape::list);
         center    = parse_point<dim>(prm.get("Center"), place, "Center");
         size_text = prm.get("Size");
         size      = parse_double_list(size_text, place, "Size");
@@ -259,8 +259,8 @@ namespace ImmersedGrains
                         "File",
                         placement_file,
                         "Shape = file needs a file name");
-        if (enabled && (shape == PlacementShape::ball ||
-                        shape == PlacementShape::box) &&
+        if (enabled &&
+            (shape == PlacementShape::ball || shape == PlacementShape::box) &&
             count == 0 && radii.empty())
           place.require(solid_fraction > 0 && solid_fraction < 1,
                         "Solid fraction",
@@ -274,15 +274,15 @@ namespace ImmersedGrains
     prm.enter_subsection("Contacts");
     {
       const InputLocation where{file, "Contacts"};
-      contacts_enabled         = prm.get_bool("Enabled");
-      contact.restitution      = prm.get_double("Restitution");
-      contact.friction         = prm.get_double("Friction");
-      contact.tolerance        = prm.get_double("Tolerance");
+      contacts_enabled          = prm.get_bool("Enabled");
+      contact.restitution       = prm.get_double("Restitution");
+      contact.friction          = prm.get_double("Friction");
+      contact.tolerance         = prm.get_double("Tolerance");
       contact.overlap_tolerance = prm.get_double("Overlap tolerance");
-      contact.max_iterations   = prm.get_integer("Max iterations");
-      contact.warm_start       = prm.get_bool("Warm start");
-      alert_distance           = prm.get_double("Alert distance");
-      stop_on_failure          = prm.get_bool("Stop on failure");
+      contact.max_iterations    = prm.get_integer("Max iterations");
+      contact.warm_start        = prm.get_bool("Warm start");
+      alert_distance            = prm.get_double("Alert distance");
+      stop_on_failure           = prm.get_bool("Stop on failure");
       where.require(contact.tolerance > 0,
                     "Tolerance",
                     prm.get("Tolerance"),
@@ -297,7 +297,7 @@ namespace ImmersedGrains
     prm.enter_subsection("Gravity");
     {
       const InputLocation where{file, "Gravity"};
-      const auto          g = parse_point<dim>(prm.get("Vector"), where, "Vector");
+      const auto g = parse_point<dim>(prm.get("Vector"), where, "Vector");
       for (unsigned int d = 0; d < dim; ++d)
         gravity[d] = g[d];
     }

@@ -17,9 +17,8 @@ namespace ImmersedGrains
     {
       using namespace dealii::DataComponentInterpretation;
       GrainPropertyLayout l;
-      const auto          add = [&](const std::string &name,
-                           const unsigned int n,
-                           const bool         vector)
+      const auto          add =
+        [&](const std::string &name, const unsigned int n, const bool vector)
       {
         const unsigned int first = l.n_properties;
         for (unsigned int c = 0; c < n; ++c)
@@ -65,8 +64,8 @@ namespace ImmersedGrains
     // Grains whose centre leaves the mesh where it is not open would vanish
     // silently in the sort; move_and_scatter() prevents it, this counts any
     // that slip through so that they are reported.
-    particles.signals.particle_lost.connect(
-      [this](const auto &, const auto &) { ++lost; });
+    particles.signals.particle_lost.connect([this](const auto &, const auto &)
+                                            { ++lost; });
     update_partition();
   }
 
@@ -126,7 +125,8 @@ namespace ImmersedGrains
     AssertThrow(particles.n_global_particles() == seeds.size(),
                 dealii::ExcMessage(
                   "Grains: " +
-                  std::to_string(seeds.size() - particles.n_global_particles()) +
+                  std::to_string(seeds.size() -
+                                 particles.n_global_particles()) +
                   " grains could not be located in the mesh."));
   }
 
@@ -146,7 +146,7 @@ namespace ImmersedGrains
     double v_max = 0, r_min = std::numeric_limits<double>::max();
     for (const auto &p : particles)
     {
-      const auto     props = p.get_properties();
+      const auto             props = p.get_properties();
       dealii::Tensor<1, dim> v;
       for (unsigned int d = 0; d < dim; ++d)
         v[d] = props[properties.velocity + d];
@@ -180,9 +180,9 @@ namespace ImmersedGrains
   Grains<dim>::gather()
   {
     dealii::TimerOutput::Scope scope(timer, "grains: gather");
-    const unsigned int n        = particles.n_locally_owned_particles();
-    const bool         friction = properties.angular_velocity !=
-                          GrainPropertyLayout::absent;
+    const unsigned int         n = particles.n_locally_owned_particles();
+    const bool                 friction =
+      properties.angular_velocity != GrainPropertyLayout::absent;
     auto &c = arrays.contact;
     arrays.position.resize(n);
     arrays.mass.resize(n);
@@ -204,9 +204,9 @@ namespace ImmersedGrains
       arrays.position[i] = p.get_location();
       for (unsigned int d = 0; d < dim; ++d)
         c.velocity[i][d] = props[properties.velocity + d];
-      c.radius[i]     = props[properties.radius];
-      c.id[i]         = p.get_id();
-      arrays.mass[i]  = mass(c.radius[i]);
+      c.radius[i]    = props[properties.radius];
+      c.id[i]        = p.get_id();
+      arrays.mass[i] = mass(c.radius[i]);
       if (friction)
         for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
           c.angular_velocity[i][d] = props[properties.angular_velocity + d];
@@ -243,8 +243,9 @@ namespace ImmersedGrains
         }
         continue;
       }
-      dealii::Tensor<1, dim> momentum = m * (c.velocity[i] + dt * parameters.gravity);
-      double                 m_eff    = m;
+      dealii::Tensor<1, dim> momentum =
+        m * (c.velocity[i] + dt * parameters.gravity);
+      double m_eff = m;
       if (force)
         momentum += dt * arrays.external_force[i];
       if (drag)
@@ -268,7 +269,7 @@ namespace ImmersedGrains
     if (!contacts)
       return report;
     dealii::TimerOutput::Scope scope(timer, "grains: contacts");
-    auto  &c     = arrays.contact;
+    auto                      &c = arrays.contact;
     double v_max = 0, r_min = std::numeric_limits<double>::max();
     for (unsigned int i = 0; i < c.velocity.size(); ++i)
     {
@@ -302,16 +303,17 @@ namespace ImmersedGrains
   Grains<dim>::move_and_scatter(const double dt)
   {
     dealii::TimerOutput::Scope scope(timer, "grains: move and sort");
-    const auto   &c        = arrays.contact;
-    const bool    friction = !c.angular_velocity.empty();
-    const auto   &lo       = geometry.lower_corner;
-    const auto   &hi       = geometry.upper_corner;
-    std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator>
+    const auto                &c        = arrays.contact;
+    const bool                 friction = !c.angular_velocity.empty();
+    const auto                &lo       = geometry.lower_corner;
+    const auto                &hi       = geometry.upper_corner;
+    std::vector<
+      typename dealii::Particles::ParticleHandler<dim>::particle_iterator>
                  leaving;
     unsigned int i = 0;
     for (auto p = particles.begin(); p != particles.end(); ++p, ++i)
     {
-      dealii::Point<dim> x = arrays.position[i] + dt * c.velocity[i];
+      dealii::Point<dim> x    = arrays.position[i] + dt * c.velocity[i];
       bool               left = false;
       for (unsigned int d = 0; d < dim; ++d)
       {
@@ -377,22 +379,23 @@ namespace ImmersedGrains
     const bool friction =
       properties.angular_velocity != GrainPropertyLayout::absent;
     const dealii::Tensor<1, dim> down =
-      parameters.gravity.norm() > 0 ? parameters.gravity / parameters.gravity.norm() :
-                                      dealii::Tensor<1, dim>();
+      parameters.gravity.norm() > 0 ?
+        parameters.gravity / parameters.gravity.norm() :
+        dealii::Tensor<1, dim>();
     unsigned int axis = 0;
     for (unsigned int d = 1; d < dim; ++d)
       if (std::abs(down[d]) > std::abs(down[axis]))
         axis = d;
-    const double floor = down[axis] < 0 ? geometry.lower_corner[axis] :
-                                          geometry.upper_corner[axis];
+    const double        floor = down[axis] < 0 ? geometry.lower_corner[axis] :
+                                                 geometry.upper_corner[axis];
     std::vector<double> sums(3 + 2 * dim + 1, 0.);
     double              max_speed = 0;
     for (const auto &p : particles)
     {
-      const auto   props = p.get_properties();
-      const double r     = props[properties.radius];
-      const double V     = grain_volume<dim>(r);
-      const double m     = mass(r);
+      const auto             props = p.get_properties();
+      const double           r     = props[properties.radius];
+      const double           V     = grain_volume<dim>(r);
+      const double           m     = mass(r);
       dealii::Tensor<1, dim> v;
       for (unsigned int d = 0; d < dim; ++d)
         v[d] = props[properties.velocity + d];
@@ -437,7 +440,8 @@ namespace ImmersedGrains
         if (d != axis)
           section *= geometry.upper_corner[d] - geometry.lower_corner[d];
       const double height = sums[3 + 2 * dim] / s.solid_volume;
-      s.packing_fraction = height > 0 ? s.solid_volume / (section * 2 * height) : 0;
+      s.packing_fraction =
+        height > 0 ? s.solid_volume / (section * 2 * height) : 0;
     }
     return s;
   }

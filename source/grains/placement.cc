@@ -40,8 +40,8 @@ namespace ImmersedGrains
       {
         // Box-Muller; 1 - u keeps the logarithm finite.
         const double u = 1 - uniform(), v = uniform();
-        return mean + deviation * std::sqrt(-2 * std::log(u)) *
-                        std::cos(2 * M_PI * v);
+        return mean +
+               deviation * std::sqrt(-2 * std::log(u)) * std::cos(2 * M_PI * v);
       }
     };
 
@@ -153,10 +153,8 @@ namespace ImmersedGrains
       unsigned int                  n_total = 1;
       for (unsigned int d = 0; d < dim; ++d)
       {
-        n_cells[d] = std::max(1.,
-                              std::min(1e3,
-                                       std::floor((upper[d] - lower[d]) /
-                                                  (2 * r_max))));
+        n_cells[d] = std::max(
+          1., std::min(1e3, std::floor((upper[d] - lower[d]) / (2 * r_max))));
         n_total *= n_cells[d];
       }
       std::vector<std::vector<unsigned int>> cells(n_total);
@@ -195,8 +193,8 @@ namespace ImmersedGrains
           // Visit the 3^dim neighbour cells.
           for (unsigned int k = 0; k < std::pow(3, dim) && free; ++k)
           {
-            std::array<int, dim> n = c;
-            unsigned int         q = k;
+            std::array<int, dim> n      = c;
+            unsigned int         q      = k;
             bool                 inside = true;
             for (unsigned int d = 0; d < dim; ++d, q /= 3)
             {
@@ -244,8 +242,7 @@ namespace ImmersedGrains
     {
       const InputLocation where{prm.file, "Grains/Placement"};
       std::vector<double> radii = prm.radii;
-      double              r_max =
-        prm.radius_distribution == RadiusDistribution::constant ?
+      double r_max = prm.radius_distribution == RadiusDistribution::constant ?
                        prm.radius :
                        prm.max_radius;
       if (!radii.empty())
@@ -267,8 +264,8 @@ namespace ImmersedGrains
       where.require(count <= sites,
                     radii.empty() ? "Count" : "Radii",
                     radii.empty() ? prm.count_text : prm.radii_text,
-                    "the lattice in the box has only " +
-                      std::to_string(sites) + " sites");
+                    "the lattice in the box has only " + std::to_string(sites) +
+                      " sites");
       std::vector<GrainSeed<dim>> grains;
       for (unsigned int k = 0; k < count; ++k)
       {
@@ -276,8 +273,8 @@ namespace ImmersedGrains
         unsigned int q = k;
         for (unsigned int d = 0; d < dim; ++d)
         {
-          x[d] = prm.center[d] - prm.size[d] / 2 + r_max +
-                 2 * r_max * (q % n[d]);
+          x[d] =
+            prm.center[d] - prm.size[d] / 2 + r_max + 2 * r_max * (q % n[d]);
           q /= n[d];
         }
         const double r = radii.empty() ? draw_radius(prm, random) : radii[k];
@@ -376,10 +373,10 @@ namespace ImmersedGrains
       std::array<bool, dim> periodic;
       double                r_max = *std::max_element(r.begin(), r.end());
       for (unsigned int d = 0; d < dim; ++d)
-        periodic[d] = geometry.is_periodic(d) &&
-                      geometry.upper_corner[d] - geometry.lower_corner[d] >=
-                        4 * r_max;
-      Contact::BucketGrid<dim> grid(geometry.lower_corner,
+        periodic[d] =
+          geometry.is_periodic(d) &&
+          geometry.upper_corner[d] - geometry.lower_corner[d] >= 4 * r_max;
+      Contact::BucketGrid<dim>             grid(geometry.lower_corner,
                                     geometry.upper_corner,
                                     periodic);
       std::vector<Contact::GrainPair<dim>> pairs;
@@ -481,7 +478,8 @@ namespace ImmersedGrains
                       std::to_string(grains.size()) + ")");
       for (unsigned int k = 0; k < grains.size(); ++k)
       {
-        const Point<dim> &v = prm.velocities[prm.velocities.size() == 1 ? 0 : k];
+        const Point<dim> &v =
+          prm.velocities[prm.velocities.size() == 1 ? 0 : k];
         for (unsigned int d = 0; d < dim; ++d)
           grains[k].velocity[d] = v[d];
       }

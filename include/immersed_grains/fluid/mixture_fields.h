@@ -14,8 +14,8 @@ namespace ImmersedGrains
   /**
    * What the fluid sees of the grains at the quadrature points of one cell:
    * fluid fraction phi and its gradient, a continuous drag coefficient beta,
-   * the grain velocity u_p, and the divergence of the solid volume flux
-   * (1 - phi) u_p that enters the mixture continuity equation.
+   * the grain velocity u_p, and the solid volume flux (1 - phi) u_p that
+   * enters the mixture continuity equation.
    */
   template <int dim>
   struct MixtureValues
@@ -27,7 +27,7 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> fluid_fraction_gradient;
     std::vector<double>                 drag_coefficient;
     std::vector<dealii::Tensor<1, dim>> grain_velocity;
-    std::vector<double>                 solid_flux_divergence;
+    std::vector<dealii::Tensor<1, dim>> solid_flux; // (1 - phi) u_p
     std::vector<double>                 mass_source;
   };
 

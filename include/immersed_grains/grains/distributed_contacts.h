@@ -49,7 +49,7 @@ namespace ImmersedGrains
   class DistributedContacts
   {
   public:
-    DistributedContacts(const Geometry<dim>               &geometry,
+    DistributedContacts(const Geometry<dim>              &geometry,
                         const Contact::ContactParameters &parameters,
                         MPI_Comm                          comm);
 
@@ -82,10 +82,10 @@ namespace ImmersedGrains
     contact_forces() const;
 
   private:
-    MPI_Comm           comm;
-    const unsigned int my_rank;
-    const unsigned int n_ranks;
-    const bool         friction;
+    MPI_Comm             comm;
+    const unsigned int   my_rank;
+    const unsigned int   n_ranks;
+    const bool           friction;
     const Geometry<dim> &geometry;
 
     Contact::BucketGrid<dim>    grid;
@@ -98,17 +98,17 @@ namespace ImmersedGrains
     static constexpr unsigned int sweeps_per_exchange = 4;
 
     // This step's work: owned grains then ghosts.
-    unsigned int                           n_owned = 0;
-    double                                 time_step = 0;
-    std::vector<dealii::Point<dim>>        all_positions;
-    std::vector<unsigned int>              ghost_owner;
-    std::map<unsigned int, std::vector<unsigned int>> send_lists; // owned
-    std::map<unsigned int, std::vector<unsigned int>> recv_lists; // ghosts
-    std::vector<unsigned int>              multiplicity;          // owned
-    std::vector<Contact::GrainPair<dim>>   pairs;
-    std::vector<Contact::WallContact<dim>> wall_contacts;
-    std::vector<std::uint64_t>             ids;
-    std::vector<double>                    send_buffer, recv_buffer;
+    unsigned int                                      n_owned   = 0;
+    double                                            time_step = 0;
+    std::vector<dealii::Point<dim>>                   all_positions;
+    std::vector<unsigned int>                         ghost_owner;
+    std::map<unsigned int, std::vector<unsigned int>> send_lists;   // owned
+    std::map<unsigned int, std::vector<unsigned int>> recv_lists;   // ghosts
+    std::vector<unsigned int>                         multiplicity; // owned
+    std::vector<Contact::GrainPair<dim>>              pairs;
+    std::vector<Contact::WallContact<dim>>            wall_contacts;
+    std::vector<std::uint64_t>                        ids;
+    std::vector<double>                               send_buffer, recv_buffer;
 
     double
     distance_to_rank(const dealii::Point<dim> &x, unsigned int rank) const;

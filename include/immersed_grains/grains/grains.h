@@ -28,7 +28,8 @@ namespace ImmersedGrains
    */
   struct GrainPropertyLayout
   {
-    static constexpr unsigned int absent = dealii::numbers::invalid_unsigned_int;
+    static constexpr unsigned int absent =
+      dealii::numbers::invalid_unsigned_int;
 
     unsigned int velocity         = 0;
     unsigned int radius           = absent;
@@ -38,7 +39,8 @@ namespace ImmersedGrains
 
     /** Names and interpretations per component, for particle output. */
     std::vector<std::string> names;
-    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+    std::vector<
+      dealii::DataComponentInterpretation::DataComponentInterpretation>
       interpretations;
   };
 
@@ -72,8 +74,8 @@ namespace ImmersedGrains
   template <int dim>
   struct GrainStatistics
   {
-    double                 n_grains       = 0;
-    double                 solid_volume   = 0;
+    double                 n_grains     = 0;
+    double                 solid_volume = 0;
     dealii::Point<dim>     centroid;
     dealii::Tensor<1, dim> mean_velocity;
     double                 max_speed        = 0;
@@ -171,10 +173,10 @@ namespace ImmersedGrains
     MPI_Comm                                                 comm;
     dealii::TimerOutput                                     &timer;
 
-    dealii::MappingQ1<dim>                  mapping;
-    GrainPropertyLayout                     properties;
-    dealii::Particles::ParticleHandler<dim> particles;
-    std::unique_ptr<DistributedContacts<dim>> contacts;
+    dealii::MappingQ1<dim>                             mapping;
+    GrainPropertyLayout                                properties;
+    dealii::Particles::ParticleHandler<dim>            particles;
+    std::unique_ptr<DistributedContacts<dim>>          contacts;
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
 
     GrainStepArrays<dim> arrays;

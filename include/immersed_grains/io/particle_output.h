@@ -28,9 +28,9 @@ namespace ImmersedGrains
           const std::vector<std::string>                &names,
           const std::vector<
             dealii::DataComponentInterpretation::DataComponentInterpretation>
-                            &interpretations,
-          double             time,
-          unsigned int       step);
+                      &interpretations,
+          double       time,
+          unsigned int step);
 
   private:
     std::string                                 directory;
