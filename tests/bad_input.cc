@@ -99,6 +99,59 @@ end
          "set Dimension = 2\nsubsection Fluid\n  set Time scheme = BDF7\nend\n",
          "Time scheme",
          "BDF7"},
+        {"grains_overlap",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.1\n  subsection Placement\n    set Positions = 0.5, "
+             "0.5; 0.6, 0.5\n  end\nend\n",
+         "Positions",
+         "0.5, 0.5; 0.6, 0.5"},
+        {"grains_outside_domain",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.1\n  subsection Placement\n    set Positions = 0.5, "
+             "0.95\n  end\nend\n",
+         "Positions",
+         "0.5, 0.95"},
+        {"grains_impossible_fraction",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.02\n  subsection Placement\n    set Shape = box\n    "
+             "set Size = 0.5\n    set Solid fraction = 0.7\n  end\nend\n",
+         "Solid fraction",
+         "0.7"},
+        {"grains_fill_outside_domain",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.02\n  subsection Placement\n    set Shape = box\n    "
+             "set Size = 1.5, 0.5\n  end\nend\n",
+         "Size",
+         "1.5, 0.5"},
+        {"grains_missing_file",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  "
+             "subsection Placement\n    set Shape = file\n    set File = "
+             "no_such_grains.txt\n  end\nend\n",
+         "File",
+         "no_such_grains.txt"},
+        {"grains_velocity_count",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.1\n  subsection Placement\n    set Positions = 0.2, "
+             "0.5; 0.5, 0.5; 0.8, 0.5\n    set Velocities = 1, 0; 2, 0\n  "
+             "end\nend\n",
+         "Velocities",
+         "1, 0; 2, 0"},
+        {"grains_lattice_too_many",
+         "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.1\n  subsection Placement\n    set Shape = lattice\n  "
+             "  set Size = 0.4\n    set Count = 5\n  end\nend\n",
+         "Count",
+         "5"},
+        {"grains_negative_restitution",
+         "set Dimension = 2\nsubsection Contacts\n  set Restitution = "
+             "-0.5\nend\n",
+         "Restitution",
+         "-0.5"},
+        {"bad_test_check",
+         "set Dimension = 2\nsubsection Output\n  set Test checks = "
+             "kinetic_energy << 1\nend\n",
+         "Test checks",
+         "kinetic_energy << 1"},
         {"unknown_test_column",
          "set Dimension = 2\nsubsection Output\n  set Test columns = step, "
              "nonsense\nend\n",
