@@ -224,14 +224,32 @@ namespace ImmersedGrains
       {
         drags.clear();
         point_drag_source->point_drags(cell, drags);
+        if (cell_averaged_drag && !drags.empty())
+        {
+          // The cell averages of the velocity shape functions: the drag of
+          // each grain spread evenly over its cell and felt against the
+          // cell-mean velocity.
+          double volume = 0;
+          std::fill(point_shape.begin(), point_shape.end(), 0.0);
+          for (unsigned int q = 0; q < n_q; ++q)
+          {
+            volume += fe_values.JxW(q);
+            for (unsigned int k = 0; k < dofs_per_cell; ++k)
+              if (fe.system_to_component_index(k).first < dim)
+                point_shape[k] += fe_values.shape_value(k, q) * fe_values.JxW(q);
+          }
+          for (auto &v : point_shape)
+            v /= volume;
+        }
         for (const auto &drag : drags)
         {
-          for (unsigned int k = 0; k < dofs_per_cell; ++k)
-          {
-            const unsigned int c = fe.system_to_component_index(k).first;
-            point_shape[k] =
-              c < dim ? fe.shape_value(k, drag.reference_location) : 0.0;
-          }
+          if (!cell_averaged_drag)
+            for (unsigned int k = 0; k < dofs_per_cell; ++k)
+            {
+              const unsigned int c = fe.system_to_component_index(k).first;
+              point_shape[k] =
+                c < dim ? fe.shape_value(k, drag.reference_location) : 0.0;
+            }
           dealii::Tensor<1, dim> u_at_grain;
           for (unsigned int k = 0; k < dofs_per_cell; ++k)
             if (point_shape[k] != 0)

@@ -129,9 +129,11 @@ namespace ImmersedGrains
   template <int dim>
   void
   FluidSolver<dim>::set_point_drag_source(
-    std::shared_ptr<const PointDragSource<dim>> source)
+    std::shared_ptr<const PointDragSource<dim>> source,
+    const bool                                  cell_averaged)
   {
-    point_drag_source = source;
+    point_drag_source  = source;
+    cell_averaged_drag = cell_averaged;
   }
 
 
@@ -164,6 +166,33 @@ namespace ImmersedGrains
         else
           values[q].pressure_gradient +=
             coefficient * fe_values.shape_grad(i, q);
+    }
+    if (cell_averaged_drag)
+    {
+      // The cell-mean velocity, the one the averaged drag is felt against.
+      const dealii::QGauss<dim> quadrature(fe.degree + 1);
+      dealii::FEValues<dim>     cell_values(mapping,
+                                        fe,
+                                        quadrature,
+                                        dealii::update_values |
+                                          dealii::update_JxW_values);
+      cell_values.reinit(cell);
+      dealii::Tensor<1, dim> mean;
+      double                 volume = 0;
+      for (unsigned int q = 0; q < quadrature.size(); ++q)
+      {
+        volume += cell_values.JxW(q);
+        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+        {
+          const unsigned int component = fe.system_to_component_index(i).first;
+          if (component < dim)
+            mean[component] += solution(indices[i]) *
+                               cell_values.shape_value(i, q) *
+                               cell_values.JxW(q);
+        }
+      }
+      for (auto &v : values)
+        v.velocity = mean / volume;
     }
     return values;
   }

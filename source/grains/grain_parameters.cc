@@ -133,8 +133,8 @@ namespace ImmersedGrains
                         Double(0),
                         "Pairs closer than this at the start of a step are "
                         "contact candidates [m]; 0: automatic (a tenth of "
-                        "the smallest radius plus twice the largest "
-                        "displacement of the step).");
+                        "the smallest radius plus three times the largest "
+                        "free displacement of the step).");
       prm.declare_entry("Warm start",
                         "true",
                         Bool(),

@@ -56,6 +56,7 @@ namespace ImmersedGrains
       std::string                               drag_law = "Dallavalle-Wen-Yu";
       bool                                      two_way  = true;
       bool                                      tracers  = false;
+      std::string                               drag_distribution = "cell";
       typename SolidFraction<dim>::Parameters   projection;
     };
 

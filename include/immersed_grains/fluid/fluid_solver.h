@@ -64,9 +64,15 @@ namespace ImmersedGrains
     void
     set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields);
 
-    /** Grains' implicit drag as point terms (none by default). */
+    /**
+     * Grains' implicit drag (none by default): at each grain's centre
+     * through the shape functions (@p cell_averaged false), or spread over
+     * its cell against the cell-mean velocity (true), which removes most of
+     * the velocity a point force induces at its own location.
+     */
     void
-    set_point_drag_source(std::shared_ptr<const PointDragSource<dim>> source);
+    set_point_drag_source(std::shared_ptr<const PointDragSource<dim>> source,
+                          bool cell_averaged = false);
 
     /** Fluid velocity, its gradient and the pressure gradient at a point of
      * a cell (for the interaction force on a grain). */
@@ -75,6 +81,7 @@ namespace ImmersedGrains
       dealii::Tensor<1, dim> velocity;
       dealii::Tensor<1, dim> pressure_gradient;
     };
+    /** With the cell-averaged drag the velocity is the cell mean. */
     std::vector<PointValues>
     point_values(
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
@@ -175,6 +182,7 @@ namespace ImmersedGrains
 
     std::shared_ptr<const MixtureFields<dim>>   mixture_fields;
     std::shared_ptr<const PointDragSource<dim>> point_drag_source;
+    bool                                        cell_averaged_drag = false;
     std::shared_ptr<dealii::Function<dim>>    forcing;
     std::shared_ptr<dealii::Function<dim>>    boundary_velocity;
 
