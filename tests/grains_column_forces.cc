@@ -24,6 +24,7 @@ column()
   const double       g = 10, r = 0.05, m = 1, dt = 1e-3;
   const unsigned int n = 10;
   std::ostringstream scene;
+  scene.precision(17);
   scene << "subsection Mesh\n"
         << "  set Lower corner = " << (dim == 2 ? "0, 0" : "0, 0, 0") << '\n'
         << "  set Upper corner = " << (dim == 2 ? "1, 1.5" : "1, 1, 1.5")
@@ -74,8 +75,7 @@ column()
       if (c.force == 0)
         continue;
       const double expected = (n - k) * m * g;
-      if (std::getenv("IG_DEBUG") && std::abs(c.force - expected) > 1e-8 * expected) std::cerr << step << " " << k << " " << (c.force - expected) / expected << "\n";
-      worst = std::max(worst, std::abs(c.force - expected) / expected);
+      worst       = std::max(worst, std::abs(c.force - expected) / expected);
       last[n - k] = c.force / (m * g);
       ++count;
     }
@@ -96,7 +96,7 @@ column()
     std::cout << "\n  all 10 contacts active at every step: "
               << (complete == 1000 ? "yes" : "no")
               << "\n  forces = j m g to 1e-8 at every step: "
-              << (worst < 1e-8 ? "yes" : "no") << (std::getenv("IG_DEBUG") ? " " : "") << (std::getenv("IG_DEBUG") ? worst : 0.)
+              << (worst < 1e-8 ? "yes" : "no")
               << "\n  drift < 1e-11 r: " << (drift < 1e-11 ? "yes" : "no")
               << std::endl;
   }
