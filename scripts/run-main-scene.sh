@@ -4,5 +4,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 source scripts/environment.sh
-scene=${1:-prm/porous_channel.prm}
+scene=${1:-prm/falling_cloud_2d.prm}
 build/immersed-grains "$scene"

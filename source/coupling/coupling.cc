@@ -56,9 +56,9 @@ namespace ImmersedGrains
   {
     prm.enter_subsection("Coupling");
     {
-      drag_law = prm.get("Drag law");
-      tracers  = prm.get_bool("Tracers");
-      two_way  = prm.get_bool("Two-way") && !tracers;
+      drag_law          = prm.get("Drag law");
+      tracers           = prm.get_bool("Tracers");
+      two_way           = prm.get_bool("Two-way") && !tracers;
       drag_distribution = prm.get("Drag distribution");
       projection.parse_parameters(prm, file);
     }
@@ -75,17 +75,18 @@ namespace ImmersedGrains
     const double                                             fluid_density,
     const double                                             fluid_viscosity,
     dealii::TimerOutput                                     &timer)
-    : parameters(parameters)
-    , grain_parameters(grain_parameters)
-    , triangulation(tria)
-    , density(fluid_density)
-    , viscosity(fluid_viscosity)
-    , timer(timer)
-    , projection(std::make_shared<SolidFraction<dim>>(parameters.projection,
-                                                      geometry,
-                                                      tria))
-    , drag_law(DragLaw::create(parameters.drag_law))
-  {}
+      : parameters(parameters)
+      , grain_parameters(grain_parameters)
+      , triangulation(tria)
+      , density(fluid_density)
+      , viscosity(fluid_viscosity)
+      , timer(timer)
+      , projection(std::make_shared<SolidFraction<dim>>(parameters.projection,
+                                                        geometry,
+                                                        tria))
+      , drag_law(DragLaw::create(parameters.drag_law))
+  {
+  }
 
 
   template <int dim>
@@ -104,10 +105,9 @@ namespace ImmersedGrains
       return;
     fluid.set_mixture_fields(projection);
     // The simulation owns both; the fluid only borrows this object.
-    fluid.set_point_drag_source(
-      std::shared_ptr<const PointDragSource<dim>>(
-        this, [](const PointDragSource<dim> *) {}),
-      parameters.drag_distribution == "cell");
+    fluid.set_point_drag_source(std::shared_ptr<const PointDragSource<dim>>(
+                                  this, [](const PointDragSource<dim> *) {}),
+                                parameters.drag_distribution == "cell");
   }
 
 
@@ -118,15 +118,16 @@ namespace ImmersedGrains
     // in which Grains gathered its arrays.
     template <int dim, typename F>
     void
-    for_each_cell_batch(const dealii::Particles::ParticleHandler<dim> &particles,
-                        std::vector<dealii::Point<dim>>               &references,
-                        F                                            &&f)
+    for_each_cell_batch(
+      const dealii::Particles::ParticleHandler<dim> &particles,
+      std::vector<dealii::Point<dim>>               &references,
+      F                                            &&f)
     {
       unsigned int index = 0;
       auto         it    = particles.begin();
       while (it != particles.end())
       {
-        const auto   cell  = it->get_surrounding_cell();
+        const auto         cell  = it->get_surrounding_cell();
         const unsigned int first = index;
         references.clear();
         while (it != particles.end() && it->get_surrounding_cell() == cell)
@@ -153,20 +154,23 @@ namespace ImmersedGrains
   Coupling<dim>::project(const Grains<dim> &grains)
   {
     dealii::TimerOutput::Scope scope(timer, "coupling: solid fraction");
-    const auto &particles = grains.particle_handler();
-    const auto &layout    = grains.layout();
-    projection->project([&](const auto &cell, std::vector<GrainSample<dim>> &samples) {
-      for (const auto &p : particles.particles_in_cell(cell))
+    const auto                &particles = grains.particle_handler();
+    const auto                &layout    = grains.layout();
+    projection->project(
+      [&](const auto &cell, std::vector<GrainSample<dim>> &samples)
       {
-        const auto     props = p.get_properties();
-        GrainSample<dim> s;
-        s.reference_location = p.get_reference_location();
-        s.volume             = grain_volume<dim>(props[layout.radius]);
-        for (unsigned int d = 0; d < dim; ++d)
-          s.velocity[d] = grain_parameters.fixed ? 0.0 : props[layout.velocity + d];
-        samples.push_back(s);
-      }
-    });
+        for (const auto &p : particles.particles_in_cell(cell))
+        {
+          const auto       props = p.get_properties();
+          GrainSample<dim> s;
+          s.reference_location = p.get_reference_location();
+          s.volume             = grain_volume<dim>(props[layout.radius]);
+          for (unsigned int d = 0; d < dim; ++d)
+            s.velocity[d] =
+              grain_parameters.fixed ? 0.0 : props[layout.velocity + d];
+          samples.push_back(s);
+        }
+      });
   }
 
 
@@ -177,21 +181,22 @@ namespace ImmersedGrains
                                     const double            dt)
   {
     dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
-    auto       &arrays = const_cast<Grains<dim> &>(grains).step_arrays();
-    const auto &c      = arrays.contact;
-    const unsigned int n = c.velocity.size();
+    auto              &arrays = const_cast<Grains<dim> &>(grains).step_arrays();
+    const auto        &c      = arrays.contact;
+    const unsigned int n      = c.velocity.size();
     lagged_force.assign(n, dealii::Tensor<1, dim>());
     gamma.assign(n, 0.0);
     cell_drags.assign(triangulation.n_active_cells(), {});
     reynolds_max = 0;
 
-    const dealii::Tensor<1, dim> g = grain_parameters.gravity;
+    const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
     MixtureValues<dim>              mixture;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
-      [&](const auto &cell, const unsigned int first, const unsigned int end) {
+      [&](const auto &cell, const unsigned int first, const unsigned int end)
+      {
         const auto fluid_values = fluid.point_values(cell, references);
         projection->evaluate(cell, references, references, 0, mixture);
         for (unsigned int i = first; i < end; ++i)
@@ -233,7 +238,8 @@ namespace ImmersedGrains
         }
       });
     reynolds_max =
-      dealii::Utilities::MPI::max(reynolds_max, triangulation.get_communicator());
+      dealii::Utilities::MPI::max(reynolds_max,
+                                  triangulation.get_communicator());
   }
 
 
@@ -244,8 +250,8 @@ namespace ImmersedGrains
                                   const double            dt)
   {
     dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
-    auto              &arrays = grains.step_arrays();
-    const unsigned int n      = arrays.contact.velocity.size();
+    auto                      &arrays = grains.step_arrays();
+    const unsigned int         n      = arrays.contact.velocity.size();
     arrays.external_force.resize(n);
     arrays.drag_coefficient.resize(n);
     arrays.drag_velocity.resize(n);
@@ -254,17 +260,19 @@ namespace ImmersedGrains
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
-      [&](const auto &cell, const unsigned int first, const unsigned int end) {
+      [&](const auto &cell, const unsigned int first, const unsigned int end)
+      {
         const auto fluid_values = fluid.point_values(cell, references);
         for (unsigned int i = first; i < end; ++i)
         {
-          const auto &u = fluid_values[i - first].velocity;
+          const auto &u           = fluid_values[i - first].velocity;
           arrays.drag_velocity[i] = u;
           if (parameters.tracers)
           {
             // The limit gamma -> infinity of the implicit update: v' = u to
             // twelve digits, gravity cancelled.
-            arrays.external_force[i]   = -arrays.mass[i] * grain_parameters.gravity;
+            arrays.external_force[i] =
+              -arrays.mass[i] * grain_parameters.gravity;
             arrays.drag_coefficient[i] = 1e12 * arrays.mass[i] / dt;
             continue;
           }

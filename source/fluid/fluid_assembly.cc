@@ -146,7 +146,7 @@ namespace ImmersedGrains
           grad_phi_u[k] = fe_values[velocities].gradient(k, q);
           div_phi_u[k]  = fe_values[velocities].divergence(k, q);
           phi_p[k]      = fe_values[pressure].value(k, q);
-        grad_phi_p[k] = fe_values[pressure].gradient(k, q);
+          grad_phi_p[k] = fe_values[pressure].gradient(k, q);
         }
 
         // Strong-form pieces of the residual at this point.
@@ -170,11 +170,11 @@ namespace ImmersedGrains
         for (unsigned int i = 0; i < dofs_per_cell; ++i)
         {
           const double div_phi_v = phi * div_phi_u[i] + grad_phi * phi_u[i];
-          cell_rhs(i) -= (momentum * phi_u[i] +
-                          dealii::scalar_product(viscous, grad_phi_u[i]) -
-                          p[q] * div_phi_v - phi_p[i] * continuity +
-                          grad_phi_p[i] * solid_flux) *
-                         JxW;
+          cell_rhs(i) -=
+            (momentum * phi_u[i] +
+             dealii::scalar_product(viscous, grad_phi_u[i]) - p[q] * div_phi_v -
+             phi_p[i] * continuity + grad_phi_p[i] * solid_flux) *
+            JxW;
 
           for (unsigned int j = 0; j < dofs_per_cell; ++j)
           {
@@ -236,7 +236,8 @@ namespace ImmersedGrains
             volume += fe_values.JxW(q);
             for (unsigned int k = 0; k < dofs_per_cell; ++k)
               if (fe.system_to_component_index(k).first < dim)
-                point_shape[k] += fe_values.shape_value(k, q) * fe_values.JxW(q);
+                point_shape[k] +=
+                  fe_values.shape_value(k, q) * fe_values.JxW(q);
           }
           for (auto &v : point_shape)
             v /= volume;
@@ -265,7 +266,8 @@ namespace ImmersedGrains
             for (unsigned int j = 0; j < dofs_per_cell; ++j)
               if (point_shape[j] != 0 &&
                   fe.system_to_component_index(j).first == ci)
-                cell_matrix(i, j) += drag.beta * point_shape[i] * point_shape[j];
+                cell_matrix(i, j) +=
+                  drag.beta * point_shape[i] * point_shape[j];
             if (assemble_preconditioner_matrices)
             {
               cell_reaction(i) += drag.beta * point_shape[i] * point_shape[i];
@@ -297,17 +299,15 @@ namespace ImmersedGrains
           const auto  &n       = fe_face_values.normal_vector(q);
           const double JxW     = fe_face_values.JxW(q);
           const double outflux = face_mixture.solid_flux[q] * n;
-          const double p_open =
-            type == BoundaryType::open ?
-              parameters.open_boundary_pressure->value(
-                fe_face_values.quadrature_point(q)) :
-              0.0;
+          const double p_open  = type == BoundaryType::open ?
+                                   parameters.open_boundary_pressure->value(
+                                    fe_face_values.quadrature_point(q)) :
+                                   0.0;
           for (unsigned int i = 0; i < dofs_per_cell; ++i)
-            cell_rhs(i) -=
-              (face_mixture.fluid_fraction[q] * p_open *
-                 (fe_face_values[velocities].value(i, q) * n) -
-               fe_face_values[pressure].value(i, q) * outflux) *
-              JxW;
+            cell_rhs(i) -= (face_mixture.fluid_fraction[q] * p_open *
+                              (fe_face_values[velocities].value(i, q) * n) -
+                            fe_face_values[pressure].value(i, q) * outflux) *
+                           JxW;
         }
       }
 

@@ -65,8 +65,9 @@ namespace ImmersedGrains
       // null space for AMG's coarse solve.
       if (schur_diagonal_matrix.m() != product.m())
       {
-        dealii::TrilinosWrappers::SparsityPattern pattern(
-          owned_partitioning[1], owned_partitioning[1], mpi_communicator);
+        dealii::TrilinosWrappers::SparsityPattern pattern(owned_partitioning[1],
+                                                          owned_partitioning[1],
+                                                          mpi_communicator);
         for (const auto i : owned_partitioning[1])
         {
           pattern.add(i, i);
@@ -77,8 +78,8 @@ namespace ImmersedGrains
         schur_diagonal_matrix.reinit(pattern);
       }
       schur_diagonal_matrix = 0;
-      double       mean = 0;
-      unsigned int n    = 0;
+      double       mean     = 0;
+      unsigned int n        = 0;
       for (const auto i : owned_partitioning[1])
         for (auto entry = product.begin(i); entry != product.end(i); ++entry)
         {

@@ -54,13 +54,16 @@ namespace ImmersedGrains
         const dealii::DataPostprocessorInputs::Vector<dim> &inputs,
         std::vector<dealii::Vector<double>> &computed) const override
       {
-        const auto         cell = inputs.template get_cell<dim>();
+        const auto                      cell = inputs.template get_cell<dim>();
         MixtureValues<dim>              values;
-        std::vector<dealii::Point<dim>> reference(inputs.evaluation_points.size());
+        std::vector<dealii::Point<dim>> reference(
+          inputs.evaluation_points.size());
         for (unsigned int q = 0; q < reference.size(); ++q)
-          reference[q] = mapping.transform_real_to_unit_cell(
-            cell, inputs.evaluation_points[q]);
-        fields.evaluate(cell, inputs.evaluation_points, reference, time, values);
+          reference[q] =
+            mapping.transform_real_to_unit_cell(cell,
+                                                inputs.evaluation_points[q]);
+        fields.evaluate(
+          cell, inputs.evaluation_points, reference, time, values);
         for (unsigned int q = 0; q < computed.size(); ++q)
         {
           computed[q](0) = values.fluid_fraction[q];
@@ -81,8 +84,8 @@ namespace ImmersedGrains
       }
 
     private:
-      const MixtureFields<dim>     &fields;
-      const double                  time;
+      const MixtureFields<dim>    &fields;
+      const double                 time;
       const dealii::MappingQ1<dim> mapping;
     };
   } // namespace
@@ -148,11 +151,8 @@ namespace ImmersedGrains
     std::vector<dealii::types::global_dof_index> indices(fe.n_dofs_per_cell());
     cell->get_dof_indices(indices);
     const dealii::Quadrature<dim> points(reference_locations);
-    dealii::FEValues<dim>         fe_values(mapping,
-                                    fe,
-                                    points,
-                                    dealii::update_values |
-                                      dealii::update_gradients);
+    dealii::FEValues<dim>         fe_values(
+      mapping, fe, points, dealii::update_values | dealii::update_gradients);
     fe_values.reinit(cell);
     std::vector<PointValues> values(reference_locations.size());
     for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)

@@ -35,8 +35,8 @@ namespace ImmersedGrains
     const typename dealii::Triangulation<dim>::active_cell_iterator &,
     const std::vector<dealii::Point<dim>> &points,
     const std::vector<dealii::Point<dim>> &,
-    const double                           time,
-    MixtureValues<dim>                    &values) const
+    const double        time,
+    MixtureValues<dim> &values) const
   {
     const unsigned int n = points.size();
     values.resize(n);
@@ -57,7 +57,7 @@ namespace ImmersedGrains
 
       for (unsigned int d = 0; d < dim; ++d)
         values.grain_velocity[q][d] = grain_velocity->value(x, d);
-      values.solid_flux[q] = (1 - phi) * values.grain_velocity[q];
+      values.solid_flux[q]  = (1 - phi) * values.grain_velocity[q];
       values.mass_source[q] = mass_source ? mass_source->value(x) : 0.0;
     }
   }

@@ -153,9 +153,14 @@ namespace ImmersedGrains
       v_max = std::max(v_max, v.norm());
       r_min = std::min(r_min, props[properties.radius]);
     }
-    // Gravity adds up to |g| dt within the step.
+    // In vacuum gravity adds up to |g| dt within the step; in a fluid the
+    // implicit drag bounds the change of velocity, and the current speed
+    // is the scale.
     v_max = dealii::Utilities::MPI::max(v_max, comm) +
-            (parameters.fixed ? 0 : parameters.gravity.norm() * max_step);
+            (parameters.fixed ||
+                 properties.fluid_force != GrainPropertyLayout::absent ?
+               0 :
+               parameters.gravity.norm() * max_step);
     r_min = dealii::Utilities::MPI::min(r_min, comm);
     if (v_max <= 0 || parameters.fixed)
       return max_step;

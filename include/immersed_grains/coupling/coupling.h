@@ -53,20 +53,20 @@ namespace ImmersedGrains
       void
       parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
-      std::string                               drag_law = "Dallavalle-Wen-Yu";
-      bool                                      two_way  = true;
-      bool                                      tracers  = false;
-      std::string                               drag_distribution = "cell";
-      typename SolidFraction<dim>::Parameters   projection;
+      std::string                             drag_law = "Dallavalle-Wen-Yu";
+      bool                                    two_way  = true;
+      bool                                    tracers  = false;
+      std::string                             drag_distribution = "cell";
+      typename SolidFraction<dim>::Parameters projection;
     };
 
-    Coupling(const Parameters                                        &parameters,
-             const GrainParameters<dim>                              &grain_parameters,
-             const Geometry<dim>                                     &geometry,
+    Coupling(const Parameters           &parameters,
+             const GrainParameters<dim> &grain_parameters,
+             const Geometry<dim>        &geometry,
              const dealii::parallel::distributed::Triangulation<dim> &tria,
-             double                                                   fluid_density,
-             double                                                   fluid_viscosity,
-             dealii::TimerOutput                                     &timer);
+             double               fluid_density,
+             double               fluid_viscosity,
+             dealii::TimerOutput &timer);
 
     /** After every mesh change. */
     void
@@ -80,11 +80,15 @@ namespace ImmersedGrains
     project(const Grains<dim> &grains);
 
     void
-    prepare_fluid_drag(const Grains<dim> &grains, const FluidSolver<dim> &fluid, double dt);
+    prepare_fluid_drag(const Grains<dim>      &grains,
+                       const FluidSolver<dim> &fluid,
+                       double                  dt);
 
     /** Call after Grains::gather(), before compute_free_velocities(). */
     void
-    set_grain_forces(Grains<dim> &grains, const FluidSolver<dim> &fluid, double dt);
+    set_grain_forces(Grains<dim>            &grains,
+                     const FluidSolver<dim> &fluid,
+                     double                  dt);
 
     void
     point_drags(
@@ -114,7 +118,7 @@ namespace ImmersedGrains
     std::unique_ptr<DragLaw>            drag_law;
 
     // Per grain, in the ParticleHandler's iteration order (Grains' arrays).
-    std::vector<dealii::Tensor<1, dim>> lagged_force;  // without m g
+    std::vector<dealii::Tensor<1, dim>> lagged_force; // without m g
     std::vector<double>                 gamma;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;

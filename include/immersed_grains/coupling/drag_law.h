@@ -75,7 +75,10 @@ namespace ImmersedGrains
   {                                                                     \
     const bool registered_##classname =                                 \
       ::ImmersedGrains::DragLaw::register_law(                          \
-        name, description, [] {                                         \
+        name,                                                           \
+        description,                                                    \
+        []                                                              \
+        {                                                               \
           return std::unique_ptr<::ImmersedGrains::DragLaw>(            \
             new ::ImmersedGrains::classname());                         \
         });                                                             \

@@ -54,14 +54,15 @@ namespace ImmersedGrains
       void
       parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
-      bool   lumped               = false;
-      double smoothing_length     = 0;
-      double min_fluid_fraction   = 0.3;
+      bool   lumped             = false;
+      double smoothing_length   = 0;
+      double min_fluid_fraction = 0.3;
     };
 
-    SolidFraction(const Parameters                                        &parameters,
-                  const Geometry<dim>                                     &geometry,
-                  const dealii::parallel::distributed::Triangulation<dim> &tria);
+    SolidFraction(
+      const Parameters                                        &parameters,
+      const Geometry<dim>                                     &geometry,
+      const dealii::parallel::distributed::Triangulation<dim> &tria);
 
     /** (Re)builds DoFs and matrices; call after every mesh change. */
     void
@@ -90,11 +91,12 @@ namespace ImmersedGrains
      * grains' drag enters as point terms).
      */
     void
-    evaluate(const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
-             const std::vector<dealii::Point<dim>> &points,
-             const std::vector<dealii::Point<dim>> &reference_points,
-             double                                 time,
-             MixtureValues<dim>                    &values) const override;
+    evaluate(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>>                           &points,
+      const std::vector<dealii::Point<dim>> &reference_points,
+      double                                 time,
+      MixtureValues<dim>                    &values) const override;
 
     const dealii::DoFHandler<dim> &
     get_dof_handler() const;
@@ -120,9 +122,9 @@ namespace ImmersedGrains
     dealii::TrilinosWrappers::SparseMatrix matrix; // M + l^2 K (or lumped)
     dealii::TrilinosWrappers::MPI::Vector  lumped_inverse;
 
-    dealii::TrilinosWrappers::MPI::Vector                       fraction;
-    std::array<dealii::TrilinosWrappers::MPI::Vector, dim>       flux;
-    unsigned int                                                clamped = 0;
+    dealii::TrilinosWrappers::MPI::Vector                  fraction;
+    std::array<dealii::TrilinosWrappers::MPI::Vector, dim> flux;
+    unsigned int                                           clamped = 0;
   };
 } // namespace ImmersedGrains
 

@@ -183,8 +183,8 @@ namespace ImmersedGrains
     std::shared_ptr<const MixtureFields<dim>>   mixture_fields;
     std::shared_ptr<const PointDragSource<dim>> point_drag_source;
     bool                                        cell_averaged_drag = false;
-    std::shared_ptr<dealii::Function<dim>>    forcing;
-    std::shared_ptr<dealii::Function<dim>>    boundary_velocity;
+    std::shared_ptr<dealii::Function<dim>>      forcing;
+    std::shared_ptr<dealii::Function<dim>>      boundary_velocity;
 
     double       time       = 0;
     double       dt         = 0;

@@ -19,10 +19,10 @@ namespace ImmersedGrains
     coefficient(const DragInput &in) const override
     {
       const double phi = in.fluid_fraction, s = 1 - phi;
-      const double re  = phi * in.density * 2 * in.radius * in.slip_speed /
-                        in.viscosity;
-      const double p     = 0.5 * (1 + 4 * s);
-      const double a     = 1 / phi + 3 * s * phi;
+      const double re =
+        phi * in.density * 2 * in.radius * in.slip_speed / in.viscosity;
+      const double p = 0.5 * (1 + 4 * s);
+      const double a = 1 / phi + 3 * s * phi;
       const double inertial =
         0.413 / (24 * phi * phi) *
         (a * std::pow(re, 1 + p) + 8.4 * std::pow(re, 0.657 + p)) /

@@ -18,8 +18,9 @@ namespace ImmersedGrains
       const double phi = in.fluid_fraction;
       const double re  = reynolds(in);
       const double chi =
-        re > 0 ? 3.7 - 0.65 * std::exp(-0.5 * std::pow(1.5 - std::log10(re), 2)) :
-                 3.7;
+        re > 0 ?
+          3.7 - 0.65 * std::exp(-0.5 * std::pow(1.5 - std::log10(re), 2)) :
+          3.7;
       const double root =
         0.63 * std::sqrt(in.slip_speed) +
         4.8 * std::sqrt(in.viscosity / (2 * in.radius * in.density * phi));

@@ -20,15 +20,15 @@ namespace ImmersedGrains
     {
       const double phi = in.fluid_fraction, d = 2 * in.radius;
       if (phi > 0.8)
-        {
-          const double re = phi * in.density * d * in.slip_speed / in.viscosity;
-          const double cd_w =
-            re < 1000 ? 24 * in.viscosity / (phi * in.density * d) *
-                          (1 + 0.15 * std::pow(re, 0.687)) :
-                        0.44 * in.slip_speed;
-          return 0.75 * cd_w * in.density * phi / d * std::pow(phi, -2.65) *
-                 in.volume;
-        }
+      {
+        const double re   = phi * in.density * d * in.slip_speed / in.viscosity;
+        const double cd_w = re < 1000 ?
+                              24 * in.viscosity / (phi * in.density * d) *
+                                (1 + 0.15 * std::pow(re, 0.687)) :
+                              0.44 * in.slip_speed;
+        return 0.75 * cd_w * in.density * phi / d * std::pow(phi, -2.65) *
+               in.volume;
+      }
       return (150 * (1 - phi) * in.viscosity / (phi * d * d) +
               1.75 * in.density * in.slip_speed / d) *
              in.volume;

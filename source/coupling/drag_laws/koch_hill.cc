@@ -18,8 +18,8 @@ namespace ImmersedGrains
     coefficient(const DragInput &in) const override
     {
       const double phi = in.fluid_fraction, s = 1 - phi;
-      const double re  = phi * in.density * 2 * in.radius * in.slip_speed /
-                        in.viscosity;
+      const double re =
+        phi * in.density * 2 * in.radius * in.slip_speed / in.viscosity;
       const double s_ln_s = s > 0 ? s * std::log(s) : 0.0;
       const double f0 =
         s < 0.4 ? (1 + 3 * std::sqrt(s / 2) + 135.0 / 64 * s_ln_s + 16.14 * s) /

@@ -17,7 +17,8 @@ namespace ImmersedGrains
       const double re  = reynolds(in);
       const double bump =
         re > 0 ? std::exp(-0.5 * std::pow(1.5 - std::log10(re), 2)) : 0.0;
-      const double chi = 2.65 * (phi + 1) - (5.3 - 3.5 * phi) * phi * phi * bump;
+      const double chi =
+        2.65 * (phi + 1) - (5.3 - 3.5 * phi) * phi * phi * bump;
       const double root =
         0.63 * std::sqrt(in.slip_speed) +
         4.8 * std::sqrt(in.viscosity / (2 * in.radius * in.density * phi));
