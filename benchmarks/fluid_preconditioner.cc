@@ -137,15 +137,15 @@ run(const unsigned int level_min,
         unsigned int iterations = 0;
         bool         converged  = true;
         try
-          {
-            iterations =
-              fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0)
-                .linear_iterations;
-          }
+        {
+          iterations =
+            fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0)
+              .linear_iterations;
+        }
         catch (const std::exception &)
-          {
-            converged = false;
-          }
+        {
+          converged = false;
+        }
         const double seconds = std::chrono::duration<double>(
                                  std::chrono::steady_clock::now() - start)
                                  .count();

@@ -23,7 +23,7 @@ using namespace dealii;
 using namespace ImmersedGrains;
 
 constexpr double L = 2, H = 1, phi = 0.4, mu = 0.5, G = 3;
-constexpr double k = 6 / H;
+constexpr double k    = 6 / H;
 constexpr double beta = k * k * phi * mu;
 
 template <int dim>
@@ -31,8 +31,9 @@ class Exact : public Function<dim>
 {
 public:
   Exact()
-    : Function<dim>(dim + 1)
-  {}
+      : Function<dim>(dim + 1)
+  {
+  }
   double
   value(const Point<dim> &x, unsigned int c) const override
   {
@@ -52,19 +53,21 @@ study(const unsigned int coarse, const unsigned int levels, const double bound)
   ParameterHandler prm;
   Simulation<dim>::declare_parameters(prm);
   std::ostringstream scene;
-  scene << "subsection Mesh\n"
-        << "  set Lower corner = 0, 0" << (dim == 3 ? ", 0" : "") << "\n"
-        << "  set Upper corner = " << L << ", " << H << (dim == 3 ? ", 0.5" : "")
-        << "\n  set Subdivisions = 2, 1" << (dim == 3 ? ", 1" : "") << "\n"
-        << "  set Boundary conditions = open, open, wall, wall"
-        << (dim == 3 ? ", slip, slip" : "") << "\nend\n"
-        << "subsection Fluid\n  set Viscosity = " << mu
-        << "\n  set Advection = false\n  set Time derivative = false\n"
-        << "  subsection Linear solver\n    set Tolerance = 1e-11\n  end\n"
-        << "  subsection Fluid fraction\n    set Function expression = " << phi
-        << "\n  end\n  subsection Drag coefficient\n    set Function expression = "
-        << beta << "\n  end\n  subsection Open boundary pressure\n"
-        << "    set Function expression = " << G << " * (" << L << " - x)\n  end\nend\n";
+  scene
+    << "subsection Mesh\n"
+    << "  set Lower corner = 0, 0" << (dim == 3 ? ", 0" : "") << "\n"
+    << "  set Upper corner = " << L << ", " << H << (dim == 3 ? ", 0.5" : "")
+    << "\n  set Subdivisions = 2, 1" << (dim == 3 ? ", 1" : "") << "\n"
+    << "  set Boundary conditions = open, open, wall, wall"
+    << (dim == 3 ? ", slip, slip" : "") << "\nend\n"
+    << "subsection Fluid\n  set Viscosity = " << mu
+    << "\n  set Advection = false\n  set Time derivative = false\n"
+    << "  subsection Linear solver\n    set Tolerance = 1e-11\n  end\n"
+    << "  subsection Fluid fraction\n    set Function expression = " << phi
+    << "\n  end\n  subsection Drag coefficient\n    set Function expression = "
+    << beta << "\n  end\n  subsection Open boundary pressure\n"
+    << "    set Function expression = " << G << " * (" << L
+    << " - x)\n  end\nend\n";
   prm.parse_input_from_string(scene.str());
   Geometry<dim> geometry;
   geometry.parse_parameters(prm, "brinkman");
@@ -77,31 +80,38 @@ study(const unsigned int coarse, const unsigned int levels, const double bound)
   const double       u_max = exact.value(Point<dim>(0, H / 2), 0);
   const bool root = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   if (root)
-    std::printf("%dD Brinkman channel, kH = 6: level  |u-u_h|/|u|  |p-p_h|/|p|\n", dim);
+    std::printf(
+      "%dD Brinkman channel, kH = 6: level  |u-u_h|/|u|  |p-p_h|/|p|\n", dim);
   double last = 1;
   for (unsigned int level = coarse; level < coarse + levels; ++level)
+  {
+    parallel::distributed::Triangulation<dim> tria(MPI_COMM_WORLD);
+    geometry.initial_refinement = level;
+    geometry.create_mesh(tria);
+    FluidSolver<dim> fluid(parameters, geometry, tria, timer, pcout);
+    fluid.setup_dofs();
+    fluid.set_initial_condition();
+    fluid.solve_time_step(1, 1);
+    const auto e = fluid.compute_errors(exact);
+    // Norms of the exact fields over the channel, for relative errors.
+    double u_norm = u_max * std::sqrt(L * H * 0.5),
+           p_norm = G * L * std::sqrt(L * H / 3);
+    if (dim == 3)
     {
-      parallel::distributed::Triangulation<dim> tria(MPI_COMM_WORLD);
-      geometry.initial_refinement = level;
-      geometry.create_mesh(tria);
-      FluidSolver<dim> fluid(parameters, geometry, tria, timer, pcout);
-      fluid.setup_dofs();
-      fluid.set_initial_condition();
-      fluid.solve_time_step(1, 1);
-      const auto e = fluid.compute_errors(exact);
-      // Norms of the exact fields over the channel, for relative errors.
-      double u_norm = u_max * std::sqrt(L * H * 0.5), p_norm = G * L * std::sqrt(L * H / 3);
-      if (dim == 3)
-        {
-          u_norm *= std::sqrt(0.5);
-          p_norm *= std::sqrt(0.5);
-        }
-      last = e[0] / u_norm;
-      if (root)
-        std::printf("   %u   %9.2e   %9.2e\n", level, e[0] / u_norm, e[2] / p_norm);
+      u_norm *= std::sqrt(0.5);
+      p_norm *= std::sqrt(0.5);
     }
+    last = e[0] / u_norm;
+    if (root)
+      std::printf("   %u   %9.2e   %9.2e\n",
+                  level,
+                  e[0] / u_norm,
+                  e[2] / p_norm);
+  }
   if (root)
-    std::printf("   finest velocity error %s %.0e\n", last < bound ? "below" : "ABOVE", bound);
+    std::printf("   finest velocity error %s %.0e\n",
+                last < bound ? "below" : "ABOVE",
+                bound);
 }
 
 int

@@ -57,17 +57,20 @@ check(const bool lumped, const double smoothing)
            std::vector<GrainSample<dim>>>
     by_cell;
   for (const auto &p : positions)
+  {
+    const auto found =
+      GridTools::find_active_cell_around_point(mapping, tria, p);
+    if (found.first.state() == IteratorState::valid &&
+        found.first->is_locally_owned())
+      by_cell[found.first].push_back({found.second, volume, Tensor<1, dim>()});
+  }
+  projection.project(
+    [&](const auto &cell, std::vector<GrainSample<dim>> &grains)
     {
-      const auto found = GridTools::find_active_cell_around_point(mapping, tria, p);
-      if (found.first.state() == IteratorState::valid &&
-          found.first->is_locally_owned())
-        by_cell[found.first].push_back({found.second, volume, Tensor<1, dim>()});
-    }
-  projection.project([&](const auto &cell, std::vector<GrainSample<dim>> &grains) {
-    const auto it = by_cell.find(cell);
-    if (it != by_cell.end())
-      grains = it->second;
-  });
+      const auto it = by_cell.find(cell);
+      if (it != by_cell.end())
+        grains = it->second;
+    });
   const double total = positions.size() * volume;
   const double error = std::abs(projection.integral() - total) / total;
   const double peak  = projection.solid_fraction().linfty_norm();
@@ -87,8 +90,8 @@ main(int argc, char **argv)
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   for (const bool lumped : {false, true})
     for (const double l : {0.0, 0.05})
-      {
-        check<2>(lumped, l);
-        check<3>(lumped, l);
-      }
+    {
+      check<2>(lumped, l);
+      check<3>(lumped, l);
+    }
 }

@@ -359,8 +359,9 @@ namespace ImmersedGrains
           props[properties.angular_velocity + d] = c.angular_velocity[i][d];
     }
     particles.remove_particles(leaving);
-    const unsigned long count_before = dealii::Utilities::MPI::sum<unsigned long>(
-      particles.n_locally_owned_particles(), comm);
+    const unsigned long count_before =
+      dealii::Utilities::MPI::sum<unsigned long>(
+        particles.n_locally_owned_particles(), comm);
     particles.sort_particles_into_subdomains_and_cells();
     // A grain the ParticleHandler cannot place went through a wall or, under
     // MPI, farther than the ghost layer in one step: never drop it quietly.
@@ -371,7 +372,8 @@ namespace ImmersedGrains
                 dealii::ExcMessage(
                   std::to_string(lost_now) +
                   " grain(s) moved out of the mesh or beyond the neighbouring "
-                  "cells in one step (dt = " + std::to_string(dt) +
+                  "cells in one step (dt = " +
+                  std::to_string(dt) +
                   " s); reduce Time step or set Adaptive time step = true."));
     const unsigned long removed =
       dealii::Utilities::MPI::sum<unsigned long>(leaving.size(), comm);
