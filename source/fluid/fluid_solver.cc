@@ -241,12 +241,19 @@ namespace ImmersedGrains
 
     make_constraints();
 
+    // The system couples everything but pressure with pressure; the
+    // preconditioner's pressure mass matrix only pressure with pressure.
+    const auto make_matrix =
+      [&](const bool                               pressure_only,
+          const dealii::AffineConstraints<double> &constraints,
+          MatrixType                              &matrix)
     {
       dealii::Table<2, dealii::DoFTools::Coupling> coupling(dim + 1, dim + 1);
       for (unsigned int c = 0; c < dim + 1; ++c)
         for (unsigned int d = 0; d < dim + 1; ++d)
-          coupling[c][d] = (c == dim && d == dim) ? dealii::DoFTools::none :
-                                                    dealii::DoFTools::always;
+          coupling[c][d] = ((c == dim && d == dim) == pressure_only) ?
+                             dealii::DoFTools::always :
+                             dealii::DoFTools::none;
       dealii::TrilinosWrappers::BlockSparsityPattern sp(owned_partitioning,
                                                         owned_partitioning,
                                                         relevant_partitioning,
@@ -255,32 +262,14 @@ namespace ImmersedGrains
         dof_handler,
         coupling,
         sp,
-        update_constraints,
+        constraints,
         false,
         dealii::Utilities::MPI::this_mpi_process(mpi_communicator));
       sp.compress();
-      system_matrix.reinit(sp);
-    }
-    {
-      dealii::Table<2, dealii::DoFTools::Coupling> coupling(dim + 1, dim + 1);
-      for (unsigned int c = 0; c < dim + 1; ++c)
-        for (unsigned int d = 0; d < dim + 1; ++d)
-          coupling[c][d] = (c == dim && d == dim) ? dealii::DoFTools::always :
-                                                    dealii::DoFTools::none;
-      dealii::TrilinosWrappers::BlockSparsityPattern sp(owned_partitioning,
-                                                        owned_partitioning,
-                                                        relevant_partitioning,
-                                                        mpi_communicator);
-      dealii::DoFTools::make_sparsity_pattern(
-        dof_handler,
-        coupling,
-        sp,
-        pressure_mass_constraints,
-        false,
-        dealii::Utilities::MPI::this_mpi_process(mpi_communicator));
-      sp.compress();
-      pressure_mass_matrix.reinit(sp);
-    }
+      matrix.reinit(sp);
+    };
+    make_matrix(false, update_constraints, system_matrix);
+    make_matrix(true, pressure_mass_constraints, pressure_mass_matrix);
 
     solution.reinit(owned_partitioning,
                     relevant_partitioning,
