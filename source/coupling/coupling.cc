@@ -35,14 +35,17 @@ namespace ImmersedGrains
       prm.declare_entry(
         "Drag distribution",
         "cell",
-        Selection("cell|point"),
+        Selection("cell|point|filtered"),
         "How a grain's drag enters the fluid: 'point' through the velocity "
         "shape functions at its centre (deal.II step-70), felt against the "
         "fluid velocity there; 'cell' spread evenly over its cell, felt "
-        "against the cell-mean velocity. A point force induces a velocity "
-        "at its own location that grows as cells shrink towards the grain "
-        "size and biases the slip (doc/validation.md); 'cell' removes most "
-        "of it.");
+        "against the cell-mean velocity; 'filtered' spread with the "
+        "Helmholtz filter of length 'Smoothing length' (lumped mass), felt "
+        "against the fluid velocity filtered the same way. A grain feels "
+        "part of its own disturbance of the fluid; with 'point' and 'cell' "
+        "that part grows as cells shrink towards the grain size "
+        "(doc/validation.md), with 'filtered' it is set by the length in "
+        "metres and does not depend on the mesh.");
       SolidFraction<dim>::Parameters::declare_parameters(prm);
     }
     prm.leave_subsection();
@@ -86,6 +89,9 @@ namespace ImmersedGrains
                                                         tria))
       , drag_law(DragLaw::create(parameters.drag_law))
   {
+    if (parameters.drag_distribution == "filtered")
+      filtered_drag = std::make_unique<FilteredDrag<dim>>(
+        tria, geometry, parameters.projection.smoothing_length);
   }
 
 
@@ -94,6 +100,8 @@ namespace ImmersedGrains
   Coupling<dim>::setup()
   {
     projection->setup();
+    if (filtered_drag)
+      filtered_drag->setup();
   }
 
 
@@ -103,11 +111,45 @@ namespace ImmersedGrains
   {
     if (!parameters.two_way)
       return;
-    fluid.set_mixture_fields(projection);
     // The simulation owns both; the fluid only borrows this object.
-    fluid.set_point_drag_source(std::shared_ptr<const PointDragSource<dim>>(
-                                  this, [](const PointDragSource<dim> *) {}),
-                                parameters.drag_distribution == "cell");
+    fluid.set_mixture_fields(std::shared_ptr<const MixtureFields<dim>>(
+      this, [](const MixtureFields<dim> *) {}));
+    if (!filtered_drag)
+      fluid.set_point_drag_source(std::shared_ptr<const PointDragSource<dim>>(
+                                    this, [](const PointDragSource<dim> *) {}),
+                                  parameters.drag_distribution == "cell");
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::evaluate(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const std::vector<dealii::Point<dim>>                           &points,
+    const std::vector<dealii::Point<dim>> &reference_points,
+    const double                           time,
+    MixtureValues<dim>                    &values) const
+  {
+    projection->evaluate(cell, points, reference_points, time, values);
+    if (filtered_drag)
+      filtered_drag->evaluate(cell, reference_points, values);
+  }
+
+
+  template <int dim>
+  std::vector<dealii::Tensor<1, dim>>
+  Coupling<dim>::felt_velocity(
+    const FluidSolver<dim>                                          &fluid,
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const std::vector<dealii::Point<dim>> &references) const
+  {
+    if (filtered_drag)
+      return filtered_drag->filtered_velocity(cell, references);
+    const auto values = fluid.point_values(cell, references);
+    std::vector<dealii::Tensor<1, dim>> result(values.size());
+    for (unsigned int q = 0; q < values.size(); ++q)
+      result[q] = values[q].velocity;
+    return result;
   }
 
 
@@ -189,6 +231,9 @@ namespace ImmersedGrains
     cell_drags.assign(triangulation.n_active_cells(), {});
     reynolds_max = 0;
 
+    if (filtered_drag)
+      filtered_drag->filter_velocity(fluid.get_dof_handler(),
+                                     fluid.get_solution());
     const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
     MixtureValues<dim>              mixture;
@@ -198,6 +243,7 @@ namespace ImmersedGrains
       [&](const auto &cell, const unsigned int first, const unsigned int end)
       {
         const auto fluid_values = fluid.point_values(cell, references);
+        const auto felt         = felt_velocity(fluid, cell, references);
         projection->evaluate(cell, references, references, 0, mixture);
         for (unsigned int i = first; i < end; ++i)
         {
@@ -208,9 +254,8 @@ namespace ImmersedGrains
           // buoyancy (m g comes from Grains) and the dynamic pressure.
           lagged_force[i] =
             -density * V * g - V * fluid_values[k].pressure_gradient;
-          const dealii::Tensor<1, dim> slip =
-            c.velocity[i] - fluid_values[k].velocity;
-          const DragInput in{r,
+          const dealii::Tensor<1, dim> slip = c.velocity[i] - felt[k];
+          const DragInput              in{r,
                              projected_area<dim>(r),
                              V,
                              mixture.fluid_fraction[k],
@@ -233,6 +278,11 @@ namespace ImmersedGrains
           {
             drag.beta     = gamma[i] * m / (m + dt * gamma[i]);
             drag.velocity = c.velocity[i] + dt / m * (m * g + lagged_force[i]);
+            // The grain's update will add its contact impulse P / m to
+            // this; the last step's P predicts it, so that grains resting
+            // on each other (P = -dt m g') leave the fluid undisturbed.
+            if (!arrays.contact_impulse.empty())
+              drag.velocity += arrays.contact_impulse[i] / m;
           }
           cell_drags[cell->active_cell_index()].push_back(drag);
         }
@@ -240,6 +290,10 @@ namespace ImmersedGrains
     reynolds_max =
       dealii::Utilities::MPI::max(reynolds_max,
                                   triangulation.get_communicator());
+    if (filtered_drag && parameters.two_way)
+      filtered_drag->spread(
+        [&](const auto &cell, std::vector<PointDrag<dim>> &drags)
+        { drags = cell_drags[cell->active_cell_index()]; });
   }
 
 
@@ -256,16 +310,19 @@ namespace ImmersedGrains
     arrays.drag_coefficient.resize(n);
     arrays.drag_velocity.resize(n);
 
+    if (filtered_drag)
+      filtered_drag->filter_velocity(fluid.get_dof_handler(),
+                                     fluid.get_solution());
     std::vector<dealii::Point<dim>> references;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
       [&](const auto &cell, const unsigned int first, const unsigned int end)
       {
-        const auto fluid_values = fluid.point_values(cell, references);
+        const auto felt = felt_velocity(fluid, cell, references);
         for (unsigned int i = first; i < end; ++i)
         {
-          const auto &u           = fluid_values[i - first].velocity;
+          const auto &u           = felt[i - first];
           arrays.drag_velocity[i] = u;
           if (parameters.tracers)
           {
@@ -291,6 +348,44 @@ namespace ImmersedGrains
   {
     if (cell->active_cell_index() < cell_drags.size())
       drags = cell_drags[cell->active_cell_index()];
+  }
+
+
+  template <int dim>
+  std::pair<dealii::Tensor<1, dim>, dealii::Tensor<1, dim>>
+  Coupling<dim>::exchanged_forces(const Grains<dim>      &grains,
+                                  const FluidSolver<dim> &fluid) const
+  {
+    const MPI_Comm         comm = triangulation.get_communicator();
+    dealii::Tensor<1, dim> on_fluid, on_grains;
+    if (!parameters.two_way)
+      return {on_fluid, on_grains};
+    if (filtered_drag)
+      on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
+                                               fluid.get_solution());
+    else
+    {
+      // The point drags through the fluid velocity the grains felt.
+      std::vector<dealii::Point<dim>> references;
+      for_each_cell_batch<dim>(
+        grains.particle_handler(),
+        references,
+        [&](const auto &cell, const unsigned int, const unsigned int)
+        {
+          const auto  felt  = felt_velocity(fluid, cell, references);
+          const auto &drags = cell_drags[cell->active_cell_index()];
+          for (unsigned int k = 0; k < drags.size(); ++k)
+            on_fluid -= drags[k].beta * (felt[k] - drags[k].velocity);
+        });
+      on_fluid = dealii::Utilities::MPI::sum(on_fluid, comm);
+    }
+    // The drag in the grains' implicit update, with their final velocity.
+    const auto &arrays = const_cast<Grains<dim> &>(grains).step_arrays();
+    for (unsigned int i = 0; i < arrays.drag_coefficient.size(); ++i)
+      on_grains += arrays.drag_coefficient[i] *
+                   (arrays.drag_velocity[i] - arrays.contact.velocity[i]);
+    on_grains = dealii::Utilities::MPI::sum(on_grains, comm);
+    return {on_fluid, on_grains};
   }
 
 

@@ -37,6 +37,8 @@ namespace ImmersedGrains
           add("angular_velocity", dim == 2 ? 1 : 3, dim == 3);
       if (with_fluid)
         l.fluid_force = add("fluid_force", dim, true);
+      if (with_fluid && prm.contacts_enabled)
+        l.contact_impulse = add("contact_impulse", dim, true);
       return l;
     }
   } // namespace
@@ -201,6 +203,9 @@ namespace ImmersedGrains
     arrays.external_force.clear();
     arrays.drag_coefficient.clear();
     arrays.drag_velocity.clear();
+    const bool impulses =
+      properties.contact_impulse != GrainPropertyLayout::absent;
+    arrays.contact_impulse.resize(impulses ? n : 0);
 
     unsigned int i = 0;
     for (const auto &p : particles)
@@ -215,6 +220,9 @@ namespace ImmersedGrains
       if (friction)
         for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
           c.angular_velocity[i][d] = props[properties.angular_velocity + d];
+      if (impulses)
+        for (unsigned int d = 0; d < dim; ++d)
+          arrays.contact_impulse[i][d] = props[properties.contact_impulse + d];
       ++i;
     }
     c.start_velocity = c.velocity;
@@ -289,8 +297,16 @@ namespace ImmersedGrains
     report.alert_distance = parameters.alert_distance > 0 ?
                               parameters.alert_distance :
                               0.1 * r_min + 3 * v_max * dt;
+    std::vector<dealii::Tensor<1, dim>> free_velocity;
+    if (!arrays.contact_impulse.empty())
+      free_velocity = c.velocity;
     report.contacts =
       contacts->solve(arrays.position, c, dt, report.alert_distance);
+    for (unsigned int i = 0; i < free_velocity.size(); ++i)
+      arrays.contact_impulse[i] =
+        c.inverse_mass[i] > 0 ?
+          (c.velocity[i] - free_velocity[i]) / c.inverse_mass[i] :
+          dealii::Tensor<1, dim>();
     report.max_contact_force = contacts->max_contact_force();
     AssertThrow(report.contacts.converged || !parameters.stop_on_failure,
                 dealii::ExcMessage(
@@ -354,6 +370,21 @@ namespace ImmersedGrains
       auto props = p->get_properties();
       for (unsigned int d = 0; d < dim; ++d)
         props[properties.velocity + d] = c.velocity[i][d];
+      if (!arrays.contact_impulse.empty())
+        for (unsigned int d = 0; d < dim; ++d)
+          props[properties.contact_impulse + d] = arrays.contact_impulse[i][d];
+      if (!arrays.drag_coefficient.empty() && !arrays.external_force.empty() &&
+          properties.fluid_force != GrainPropertyLayout::absent)
+      {
+        // What the fluid exerted over the step: the forces other than
+        // gravity and the implicit drag with the end-of-step velocity.
+        const dealii::Tensor<1, dim> force =
+          arrays.external_force[i] +
+          arrays.drag_coefficient[i] *
+            (arrays.drag_velocity[i] - c.velocity[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+          props[properties.fluid_force + d] = force[d];
+      }
       if (friction)
         for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
           props[properties.angular_velocity + d] = c.angular_velocity[i][d];

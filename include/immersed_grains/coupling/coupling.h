@@ -6,6 +6,7 @@
 #include <deal.II/distributed/tria.h>
 
 #include <immersed_grains/coupling/drag_law.h>
+#include <immersed_grains/coupling/filtered_drag.h>
 #include <immersed_grains/coupling/solid_fraction.h>
 #include <immersed_grains/fluid/mixture_fields.h>
 
@@ -43,7 +44,7 @@ namespace ImmersedGrains
    * velocity and nothing else.
    */
   template <int dim>
-  class Coupling : public PointDragSource<dim>
+  class Coupling : public PointDragSource<dim>, public MixtureFields<dim>
   {
   public:
     struct Parameters
@@ -95,6 +96,28 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       std::vector<PointDrag<dim>> &drags) const override;
 
+    /**
+     * MixtureFields: the projected solid fraction and flux, and with
+     * Drag distribution = filtered the grains' drag as a field.
+     */
+    void
+    evaluate(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>>                           &points,
+      const std::vector<dealii::Point<dim>> &reference_points,
+      double                                 time,
+      MixtureValues<dim>                    &values) const override;
+
+    /**
+     * The drag force the grains exert on the fluid, integrated through the
+     * fluid's own fields, and minus the drag force the fluid exerts on the
+     * grains summed over grains (both global, of the last step); their sum
+     * is the momentum exchange error.
+     */
+    std::pair<dealii::Tensor<1, dim>, dealii::Tensor<1, dim>>
+    exchanged_forces(const Grains<dim>      &grains,
+                     const FluidSolver<dim> &fluid) const;
+
     /** Integral of the projected solid fraction. */
     double
     solid_volume() const;
@@ -115,7 +138,16 @@ namespace ImmersedGrains
     dealii::TimerOutput                                     &timer;
 
     std::shared_ptr<SolidFraction<dim>> projection;
+    std::unique_ptr<FilteredDrag<dim>>  filtered_drag; // only if chosen
     std::unique_ptr<DragLaw>            drag_law;
+
+    // The fluid velocity a grain feels: at its centre, the cell mean or
+    // the filtered velocity, by Drag distribution.
+    std::vector<dealii::Tensor<1, dim>>
+    felt_velocity(
+      const FluidSolver<dim>                                          &fluid,
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &references) const;
 
     // Per grain, in the ParticleHandler's iteration order (Grains' arrays).
     std::vector<dealii::Tensor<1, dim>> lagged_force; // without m g

@@ -4,13 +4,9 @@
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/distributed/tria.h>
-#include <deal.II/dofs/dof_handler.h>
-#include <deal.II/fe/fe_q.h>
-#include <deal.II/fe/mapping_q1.h>
-#include <deal.II/lac/affine_constraints.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <immersed_grains/coupling/helmholtz_filter.h>
 #include <immersed_grains/fluid/mixture_fields.h>
 #include <immersed_grains/mesh/geometry.h>
 
@@ -106,24 +102,10 @@ namespace ImmersedGrains
     solid_fraction() const;
 
   private:
-    void
-    solve(const dealii::TrilinosWrappers::MPI::Vector &rhs,
-          dealii::TrilinosWrappers::MPI::Vector       &ghosted_result);
-
-    const Parameters                                        &parameters;
-    const dealii::parallel::distributed::Triangulation<dim> &triangulation;
-    const Geometry<dim>                                     &geometry;
-    dealii::FE_Q<dim>                                        fe;
-    dealii::DoFHandler<dim>                                  dof_handler;
-    dealii::MappingQ1<dim>                                   mapping;
-    dealii::AffineConstraints<double>                        constraints;
-    dealii::IndexSet                                         owned, relevant;
-
-    dealii::TrilinosWrappers::SparseMatrix matrix; // M + l^2 K (or lumped)
-    dealii::TrilinosWrappers::MPI::Vector  lumped_inverse;
-
-    dealii::TrilinosWrappers::MPI::Vector                  fraction;
-    std::array<dealii::TrilinosWrappers::MPI::Vector, dim> flux;
+    const Parameters                                      &parameters;
+    HelmholtzFilter<dim>                                   filter;
+    typename HelmholtzFilter<dim>::Vector                  fraction;
+    std::array<typename HelmholtzFilter<dim>::Vector, dim> flux;
     unsigned int                                           clamped = 0;
   };
 } // namespace ImmersedGrains

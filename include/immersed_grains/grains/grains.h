@@ -35,6 +35,7 @@ namespace ImmersedGrains
     unsigned int radius           = absent;
     unsigned int angular_velocity = absent;
     unsigned int fluid_force      = absent;
+    unsigned int contact_impulse  = absent;
     unsigned int n_properties     = 0;
 
     /** Names and interpretations per component, for particle output. */
@@ -68,6 +69,12 @@ namespace ImmersedGrains
     /** Hook: the velocity the drag pulls towards (fluid velocity at the
      *  grain), with drag_coefficient. */
     std::vector<dealii::Tensor<1, dim>> drag_velocity;
+
+    /** With a fluid and contacts: each grain's contact impulse [N s], of
+     *  the last step on gather(), of this step after resolve_contacts().
+     *  The coupling predicts the drag the fluid receives with it, so that a
+     *  grain held by contacts does not push the fluid. */
+    std::vector<dealii::Tensor<1, dim>> contact_impulse;
   };
 
   /** Global measures of the grain population (sums/means over ranks). */

@@ -1,0 +1,105 @@
+#ifndef immersed_grains_coupling_helmholtz_filter_h
+#define immersed_grains_coupling_helmholtz_filter_h
+
+#include <deal.II/base/index_set.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <immersed_grains/mesh/geometry.h>
+
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /**
+   * The Q1 Helmholtz filter that turns sums over grains into fields:
+   *
+   *   (M + l^2 K) f = b,
+   *
+   * with M the consistent or the lumped (row-sum) mass matrix, K the
+   * stiffness matrix and l the filter length (0: an L2 projection). Since
+   * K 1 = 0 and the Q1 shape functions sum to one, the integral of f equals
+   * the sum of the entries of b whatever M, l, the mesh or the partition:
+   * the filter conserves what it spreads. The operator is symmetric, so the
+   * filtered value of a field u at a point x, N(x)^T A^{-1} (N, u), is the
+   * adjoint of spreading a point quantity at x: a grain that spreads its
+   * drag with the filter and feels the filtered fluid velocity exchanges
+   * exactly the momentum the fluid receives (doc/theory.md section 3).
+   * With the lumped M the matrix is an M-matrix on box meshes, so the filter
+   * of a non-negative b is non-negative.
+   */
+  template <int dim>
+  class HelmholtzFilter
+  {
+  public:
+    using Vector = dealii::TrilinosWrappers::MPI::Vector;
+
+    HelmholtzFilter(const dealii::parallel::distributed::Triangulation<dim> &,
+                    const Geometry<dim> &geometry);
+
+    /** (Re)builds DoFs and the matrix; call after every mesh change. */
+    void
+    setup(bool lumped, double length);
+
+    /** A vector over the locally owned DoFs, zero (for right-hand sides). */
+    Vector
+    make_owned_vector() const;
+
+    /** A ghosted vector, zero (for filtered fields). */
+    Vector
+    make_ghosted_vector() const;
+
+    /** Adds a cell's contributions b_j to @p rhs through the constraints. */
+    void
+    add_cell_contribution(
+      const typename dealii::DoFHandler<dim>::active_cell_iterator &cell,
+      const dealii::Vector<double>                                 &local,
+      std::vector<dealii::types::global_dof_index>                 &indices,
+      Vector                                                       &rhs) const;
+
+    /** Solves A f = @p rhs (compressed, owned) into the ghosted @p f. */
+    void
+    solve(const Vector &rhs, Vector &f) const;
+
+    /** The Q1 DoFHandler's cell of a triangulation cell. */
+    typename dealii::DoFHandler<dim>::active_cell_iterator
+    dof_cell(const typename dealii::Triangulation<dim>::active_cell_iterator
+               &cell) const;
+
+    /** Integral of a ghosted field over the locally owned cells, summed. */
+    double
+    integral(const Vector &f) const;
+
+    const dealii::DoFHandler<dim> &
+    get_dof_handler() const;
+
+    const dealii::FE_Q<dim> &
+    get_fe() const;
+
+    const dealii::MappingQ1<dim> &
+    get_mapping() const;
+
+    const dealii::IndexSet &
+    locally_owned_dofs() const;
+
+  private:
+    const dealii::parallel::distributed::Triangulation<dim> &triangulation;
+    const Geometry<dim>                                     &geometry;
+    dealii::FE_Q<dim>                                        fe;
+    dealii::DoFHandler<dim>                                  dof_handler;
+    dealii::MappingQ1<dim>                                   mapping;
+    dealii::AffineConstraints<double>                        constraints;
+    dealii::IndexSet                                         owned, relevant;
+    dealii::TrilinosWrappers::SparseMatrix                   matrix;
+    Vector                                                   lumped_inverse;
+    // A plain lumped projection is a division, not a linear solve.
+    bool diagonal = false;
+  };
+} // namespace ImmersedGrains
+
+#endif

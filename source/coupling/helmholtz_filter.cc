@@ -1,0 +1,229 @@
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/lac/trilinos_precondition.h>
+
+#include <immersed_grains/coupling/helmholtz_filter.h>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  HelmholtzFilter<dim>::HelmholtzFilter(
+    const dealii::parallel::distributed::Triangulation<dim> &tria,
+    const Geometry<dim>                                     &geometry)
+      : triangulation(tria)
+      , geometry(geometry)
+      , fe(1)
+      , dof_handler(tria)
+  {
+  }
+
+
+  template <int dim>
+  void
+  HelmholtzFilter<dim>::setup(const bool lumped, const double length)
+  {
+    const MPI_Comm comm = triangulation.get_communicator();
+    dof_handler.distribute_dofs(fe);
+    owned = dof_handler.locally_owned_dofs();
+    dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+
+    constraints.clear();
+    constraints.reinit(relevant);
+    dealii::DoFTools::make_hanging_node_constraints(dof_handler, constraints);
+    for (unsigned int d = 0; d < dim; ++d)
+      if (geometry.is_periodic(d))
+        dealii::DoFTools::make_periodicity_constraints(
+          dof_handler, 2 * d, 2 * d + 1, d, constraints);
+    constraints.close();
+
+    dealii::DynamicSparsityPattern dsp(relevant);
+    dealii::DoFTools::make_sparsity_pattern(dof_handler,
+                                            dsp,
+                                            constraints,
+                                            false);
+    dealii::SparsityTools::distribute_sparsity_pattern(dsp,
+                                                       owned,
+                                                       comm,
+                                                       relevant);
+    matrix.reinit(owned, owned, dsp, comm);
+
+    // M + l^2 K, and the row sums of M for the lumped variant.
+    const dealii::QGauss<dim>                    quadrature(2);
+    dealii::FEValues<dim>                        fe_values(mapping,
+                                    fe,
+                                    quadrature,
+                                    dealii::update_values |
+                                      dealii::update_gradients |
+                                      dealii::update_JxW_values);
+    const unsigned int                           n = fe.n_dofs_per_cell();
+    dealii::FullMatrix<double>                   cell_matrix(n, n);
+    dealii::Vector<double>                       cell_lumped(n);
+    std::vector<dealii::types::global_dof_index> indices(n);
+    Vector                                       row_sums(owned, comm);
+    const double                                 l2 = length * length;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        fe_values.reinit(cell);
+        cell_matrix = 0;
+        cell_lumped = 0;
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          for (unsigned int i = 0; i < n; ++i)
+            for (unsigned int j = 0; j < n; ++j)
+            {
+              const double mass = fe_values.shape_value(i, q) *
+                                  fe_values.shape_value(j, q) *
+                                  fe_values.JxW(q);
+              cell_lumped(i) += mass;
+              if (!lumped)
+                cell_matrix(i, j) += mass;
+              cell_matrix(i, j) +=
+                l2 * (fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q)) *
+                fe_values.JxW(q);
+            }
+        if (lumped)
+          for (unsigned int i = 0; i < n; ++i)
+            cell_matrix(i, i) += cell_lumped(i);
+        cell->get_dof_indices(indices);
+        constraints.distribute_local_to_global(cell_matrix, indices, matrix);
+        constraints.distribute_local_to_global(cell_lumped, indices, row_sums);
+      }
+    matrix.compress(dealii::VectorOperation::add);
+    row_sums.compress(dealii::VectorOperation::add);
+
+    lumped_inverse.reinit(owned, comm);
+    for (const auto i : owned)
+      lumped_inverse[i] = row_sums[i] > 0 ? 1.0 / row_sums[i] : 0.0;
+    lumped_inverse.compress(dealii::VectorOperation::insert);
+    diagonal = lumped && length == 0;
+  }
+
+
+  template <int dim>
+  typename HelmholtzFilter<dim>::Vector
+  HelmholtzFilter<dim>::make_owned_vector() const
+  {
+    return Vector(owned, triangulation.get_communicator());
+  }
+
+
+  template <int dim>
+  typename HelmholtzFilter<dim>::Vector
+  HelmholtzFilter<dim>::make_ghosted_vector() const
+  {
+    return Vector(owned, relevant, triangulation.get_communicator());
+  }
+
+
+  template <int dim>
+  void
+  HelmholtzFilter<dim>::add_cell_contribution(
+    const typename dealii::DoFHandler<dim>::active_cell_iterator &cell,
+    const dealii::Vector<double>                                 &local,
+    std::vector<dealii::types::global_dof_index>                 &indices,
+    Vector                                                       &rhs) const
+  {
+    indices.resize(fe.n_dofs_per_cell());
+    cell->get_dof_indices(indices);
+    constraints.distribute_local_to_global(local, indices, rhs);
+  }
+
+
+  template <int dim>
+  void
+  HelmholtzFilter<dim>::solve(const Vector &rhs, Vector &ghosted) const
+  {
+    Vector x(owned, triangulation.get_communicator());
+    if (diagonal)
+    {
+      x = rhs;
+      x.scale(lumped_inverse);
+    }
+    else
+    {
+      // Tight tolerance: conservation is 1^T r away from exact.
+      dealii::SolverControl    control(1000, 1e-15 * rhs.l2_norm() + 1e-300);
+      dealii::SolverCG<Vector> cg(control);
+      dealii::TrilinosWrappers::PreconditionJacobi jacobi;
+      jacobi.initialize(matrix);
+      cg.solve(matrix, x, rhs, jacobi);
+    }
+    constraints.distribute(x);
+    ghosted = x;
+  }
+
+
+  template <int dim>
+  typename dealii::DoFHandler<dim>::active_cell_iterator
+  HelmholtzFilter<dim>::dof_cell(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell) const
+  {
+    return typename dealii::DoFHandler<dim>::active_cell_iterator(
+      &triangulation, cell->level(), cell->index(), &dof_handler);
+  }
+
+
+  template <int dim>
+  double
+  HelmholtzFilter<dim>::integral(const Vector &f) const
+  {
+    const dealii::QGauss<dim> quadrature(2);
+    dealii::FEValues<dim>     fe_values(mapping,
+                                    fe,
+                                    quadrature,
+                                    dealii::update_values |
+                                      dealii::update_JxW_values);
+    std::vector<double>       values(quadrature.size());
+    double                    sum = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        fe_values.reinit(cell);
+        fe_values.get_function_values(f, values);
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          sum += values[q] * fe_values.JxW(q);
+      }
+    return dealii::Utilities::MPI::sum(sum, triangulation.get_communicator());
+  }
+
+
+  template <int dim>
+  const dealii::DoFHandler<dim> &
+  HelmholtzFilter<dim>::get_dof_handler() const
+  {
+    return dof_handler;
+  }
+
+
+  template <int dim>
+  const dealii::FE_Q<dim> &
+  HelmholtzFilter<dim>::get_fe() const
+  {
+    return fe;
+  }
+
+
+  template <int dim>
+  const dealii::MappingQ1<dim> &
+  HelmholtzFilter<dim>::get_mapping() const
+  {
+    return mapping;
+  }
+
+
+  template <int dim>
+  const dealii::IndexSet &
+  HelmholtzFilter<dim>::locally_owned_dofs() const
+  {
+    return owned;
+  }
+
+
+  template class HelmholtzFilter<2>;
+  template class HelmholtzFilter<3>;
+} // namespace ImmersedGrains
