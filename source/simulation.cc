@@ -88,7 +88,9 @@ namespace ImmersedGrains
                       Bool(),
                       "Shorten the step so that no grain moves more than "
                       "Grains/Max displacement fraction of the smallest "
-                      "radius in one step.");
+                      "radius in one step, nor more than half the shortest "
+                      "cell edge (so that the particle search, under MPI "
+                      "the ghost layer, can follow it).");
 
     prm.enter_subsection("Output");
     {

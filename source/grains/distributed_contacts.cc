@@ -69,6 +69,15 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  void
+  DistributedContacts<dim>::set_sweep_direction(
+    const dealii::Tensor<1, dim> &direction)
+  {
+    sweep_direction = direction;
+  }
+
+
+  template <int dim>
   double
   DistributedContacts<dim>::distance_to_rank(const dealii::Point<dim> &x,
                                              const unsigned int rank) const
@@ -357,6 +366,7 @@ namespace ImmersedGrains
     cut(g.inverse_inertia);
     cut(g.radius);
     cut(g.id);
+    cut(g.sweep_key);
     for (unsigned int i = 0; i < n_owned; ++i)
       if (multiplicity.size() == n_owned && multiplicity[i] > 1)
       {
@@ -396,6 +406,10 @@ namespace ImmersedGrains
       g.id = ids;
     }
 
+    g.sweep_key.clear();
+    if (sweep_direction.norm() > 0)
+      for (const auto &x : all_positions)
+        g.sweep_key.push_back(x * sweep_direction);
     grid.find_pairs(all_positions, g.radius, alert, pairs);
     walls.find_contacts(all_positions, g.radius, alert, wall_contacts);
     if (n_ranks > 1)

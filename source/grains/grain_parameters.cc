@@ -139,6 +139,15 @@ namespace ImmersedGrains
                         "true",
                         Bool(),
                         "Start from last step's impulses.");
+      prm.declare_entry("Sweep order",
+                        "height",
+                        Selection("height|index"),
+                        "Order in which Gauss-Seidel visits the contacts: "
+                        "height (sorted along gravity, up and down on "
+                        "alternate sweeps: the weight of a pile reaches its "
+                        "floor in one sweep) or index (grain order, in "
+                        "rounds: the fastest update, for scenes without a "
+                        "direction of load, or without gravity).");
       prm.declare_entry("Stop on failure",
                         "false",
                         Bool(),
@@ -283,6 +292,7 @@ namespace ImmersedGrains
       contact.warm_start        = prm.get_bool("Warm start");
       alert_distance            = prm.get_double("Alert distance");
       stop_on_failure           = prm.get_bool("Stop on failure");
+      sweep_along_gravity       = prm.get("Sweep order") == "height";
       where.require(contact.tolerance > 0,
                     "Tolerance",
                     prm.get("Tolerance"),

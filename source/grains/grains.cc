@@ -63,6 +63,10 @@ namespace ImmersedGrains
       contacts = std::make_unique<DistributedContacts<dim>>(geometry,
                                                             parameters.contact,
                                                             comm);
+    if (contacts && parameters.sweep_along_gravity &&
+        parameters.gravity.norm() > 0)
+      contacts->set_sweep_direction(-parameters.gravity /
+                                    parameters.gravity.norm());
     // Grains whose centre leaves the mesh where it is not open would vanish
     // silently in the sort; move_and_scatter() prevents it, this counts any
     // that slip through so that they are reported.
@@ -89,6 +93,11 @@ namespace ImmersedGrains
           local[0].merge_with(cell->bounding_box());
       }
     rank_boxes = dealii::Utilities::MPI::all_gather(comm, local);
+    double h   = std::numeric_limits<double>::max();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        h = std::min(h, cell->minimum_vertex_distance());
+    min_cell_size = dealii::Utilities::MPI::min(h, comm);
     if (contacts)
       contacts->set_partition(rank_boxes);
   }
@@ -166,7 +175,16 @@ namespace ImmersedGrains
     r_min = dealii::Utilities::MPI::min(r_min, comm);
     if (v_max <= 0 || parameters.fixed)
       return max_step;
-    return std::min(max_step, parameters.max_displacement * r_min / v_max);
+    // The ParticleHandler looks for a moved grain in the cells around its
+    // old cell; under MPI those are the owned and ghost cells, so a grain
+    // that moves farther in one step is lost (move_and_scatter() stops the
+    // run). Half the shortest cell edge keeps every grain within them, with
+    // room for distorted cells; a collision can speed a light grain up to
+    // (1 + e) times the speed of the grain that hits it.
+    const double cell_bound =
+      0.5 * min_cell_size / ((1 + parameters.contact.restitution) * v_max);
+    return std::min(
+      {max_step, parameters.max_displacement * r_min / v_max, cell_bound});
   }
 
 

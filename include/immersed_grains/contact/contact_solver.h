@@ -52,6 +52,13 @@ namespace ImmersedGrains
       /// Persistent grain ids (e.g. particle ids), so that warm starting
       /// survives reordering. If empty, the index is the id.
       std::vector<std::uint64_t> id;
+
+      /// Optional sweep key per grain, e.g. the height against gravity:
+      /// forward sweeps visit the contacts in increasing key of their
+      /// midpoint, backward sweeps in decreasing key (see
+      /// ContactSolver::order_rows). If empty, contacts go in rounds by
+      /// grain index, the fastest order per update.
+      std::vector<double> sweep_key;
     };
 
     struct ContactParameters
@@ -271,16 +278,18 @@ namespace ImmersedGrains
 
       // Contact m of the lists given to setup() (pairs, then walls) is row
       // row_of_input[m] of the work arrays, which are in sweep order.
-      std::vector<unsigned int> row_of_input;
-      std::vector<unsigned int> rank_count;
-      std::vector<unsigned int> round_start;
+      std::vector<unsigned int>                    row_of_input;
+      std::vector<unsigned int>                    rank_count;
+      std::vector<unsigned int>                    round_start;
+      std::vector<std::pair<double, unsigned int>> keyed_rows;
 
       ContactImpulses<dim> pair_results;
       ContactImpulses<dim> wall_results;
 
       void
       order_rows(const std::vector<GrainPair<dim>>   &pairs,
-                 const std::vector<WallContact<dim>> &wall_contacts);
+                 const std::vector<WallContact<dim>> &wall_contacts,
+                 const std::vector<double>           &sweep_key);
 
       void
       set_row(const unsigned int      k,

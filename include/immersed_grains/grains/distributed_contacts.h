@@ -63,6 +63,15 @@ namespace ImmersedGrains
       const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes);
 
     /**
+     * Gauss-Seidel visits the contacts in increasing x . @p direction on
+     * forward sweeps, decreasing on backward ones (with the upward
+     * direction: along a pile's load paths); zero: in rounds by grain
+     * index (Contact::GrainArrays::sweep_key).
+     */
+    void
+    set_sweep_direction(const dealii::Tensor<1, dim> &direction);
+
+    /**
      * Resolves the contacts of the owned grains at @p positions: grains go
      * in with free velocities and come out with end-of-step velocities.
      * The result holds global numbers (sums or maxima over ranks).
@@ -93,6 +102,7 @@ namespace ImmersedGrains
     Contact::ContactSolver<dim> solver;
 
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
+    dealii::Tensor<1, dim>                             sweep_direction;
 
     /// Local Gauss-Seidel sweeps between two glue exchanges (MPI only).
     static constexpr unsigned int sweeps_per_exchange = 4;

@@ -79,6 +79,8 @@ namespace ImmersedGrains
     Contact::ContactParameters contact;
     double                     alert_distance  = 0; // [m]; 0: automatic
     bool                       stop_on_failure = false;
+    /// Contacts/Sweep order = height: Gauss-Seidel along gravity.
+    bool sweep_along_gravity = true;
 
     // Gravity
     dealii::Tensor<1, dim> gravity;

@@ -125,12 +125,15 @@ namespace ImmersedGrains
     void
     initialize(const std::vector<GrainSeed<dim>> &seeds);
 
-    /** Recomputes the ranks' bounding boxes after the mesh changed. */
+    /** Recomputes the ranks' bounding boxes and the shortest cell edge
+     *  after the mesh changed. */
     void
     update_partition();
 
     /** Largest step <= max_step in which no grain moves more than the Max
-     *  displacement fraction of the smallest radius (collective). */
+     *  displacement fraction of the smallest radius, nor more than half the
+     *  shortest cell edge, so that the ParticleHandler (under MPI: the
+     *  ghost layer of one cell) can follow every grain (collective). */
     double
     stable_time_step(double max_step) const;
 
@@ -185,6 +188,10 @@ namespace ImmersedGrains
     dealii::Particles::ParticleHandler<dim>            particles;
     std::unique_ptr<DistributedContacts<dim>>          contacts;
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
+    /// Shortest edge of any active cell (update_partition()): the
+    /// ParticleHandler finds a grain again only within the cells around
+    /// its old one, which under MPI are owned or ghost cells.
+    double min_cell_size = 0;
 
     GrainStepArrays<dim> arrays;
     unsigned long        removed_total = 0;
