@@ -5,6 +5,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_precondition.h>
 
+#include <string>
 #include <vector>
 
 namespace ImmersedGrains
@@ -32,6 +33,19 @@ namespace ImmersedGrains
     {
       unsigned int velocity_cycles = 1;
 
+      // Inner Krylov solve of A (CG if A is symmetric, else GMRES),
+      // preconditioned by the AMG, to this relative tolerance; 0: none,
+      // velocity_cycles V-cycles instead.
+      double       inner_tolerance      = 0;
+      unsigned int inner_max_iterations = 100;
+      bool         symmetric            = true;
+
+      // ML settings of the velocity AMG (experiments; the defaults are
+      // those measured best in doc/benchmarks.md).
+      std::string  smoother_type         = "ILU";
+      unsigned int smoother_sweeps       = 2;
+      double       aggregation_threshold = 0.02;
+
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
     };
@@ -49,9 +63,22 @@ namespace ImmersedGrains
     void
     vmult(VectorType &dst, const VectorType &src) const;
 
+    /** Inner iterations on A summed over all vmult() calls (0 without an
+     * inner solve). */
+    unsigned int
+    inner_iterations() const
+    {
+      return total_inner_iterations;
+    }
+
   private:
+    void
+    solve_velocity(dealii::TrilinosWrappers::MPI::Vector       &dst,
+                   const dealii::TrilinosWrappers::MPI::Vector &src) const;
+
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
-    const unsigned int                                 velocity_cycles;
+    const Settings                                     settings;
+    mutable unsigned int total_inner_iterations = 0;
 
     dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;
