@@ -190,7 +190,9 @@ run(const unsigned int level_min,
             static_cast<unsigned long long>(fluid.n_dofs()),
             dt_text,
             beta_scaled,
-            converged ? std::to_string(iterations).c_str() : "> 1000",
+            converged ?
+              std::to_string(iterations).c_str() :
+              ("> " + std::to_string(parameters.max_linear_iterations)).c_str(),
             seconds,
             seconds / (fluid.n_dofs() * 1e-6),
             memory);

@@ -134,17 +134,18 @@ namespace ImmersedGrains
                           "AMG V-cycles per application of the velocity "
                           "block's inverse.");
         prm.declare_entry(
-          "Velocity inner tolerance",
+          "Velocity inner iterations",
           "0",
-          Double(0, 1),
-          "If positive, the velocity block's inverse is an inner Krylov "
-          "solve (CG for Stokes, GMRES with advection) preconditioned by the "
-          "AMG, to this relative residual; 0: Velocity AMG cycles V-cycles.");
-        prm.declare_entry("Velocity inner max iterations",
-                          "100",
-                          Integer(1),
-                          "Cap on the inner Krylov iterations per "
-                          "application.");
+          Integer(0, 1000),
+          "0: the velocity block's inverse is Velocity AMG cycles V-cycles "
+          "(cheap; enough up to a drag contrast of about 1e4). N > 0: up to "
+          "N GMRES iterations preconditioned by one V-cycle, for drag "
+          "jumping by many orders of magnitude (doc/benchmarks.md).");
+        prm.declare_entry("Velocity inner tolerance",
+                          "1e-6",
+                          Double(0, 1),
+                          "Relative residual at which the inner iterations "
+                          "stop before Velocity inner iterations.");
       }
       prm.leave_subsection();
 
@@ -192,23 +193,23 @@ namespace ImmersedGrains
 
       prm.enter_subsection("Linear solver");
       {
-        direct_solver            = prm.get("Type") == "direct";
-        linear_tolerance         = prm.get_double("Tolerance");
-        max_linear_iterations    = prm.get_integer("Max iterations");
-        const std::string schur  = prm.get("Schur complement");
-        schur_approximation      = schur == "pressure mass" ?
-                                     SchurApproximation::pressure_mass :
-                                     (schur == "pressure Laplacian" ?
-                                        SchurApproximation::pressure_laplace :
-                                        SchurApproximation::cahouet_chabard);
-        velocity_amg_cycles      = prm.get_integer("Velocity AMG cycles");
+        direct_solver           = prm.get("Type") == "direct";
+        linear_tolerance        = prm.get_double("Tolerance");
+        max_linear_iterations   = prm.get_integer("Max iterations");
+        const std::string schur = prm.get("Schur complement");
+        schur_approximation     = schur == "pressure mass" ?
+                                    SchurApproximation::pressure_mass :
+                                    (schur == "pressure Laplacian" ?
+                                       SchurApproximation::pressure_laplace :
+                                       SchurApproximation::cahouet_chabard);
+        velocity_amg_cycles     = prm.get_integer("Velocity AMG cycles");
+        velocity_inner_iterations =
+          prm.get_integer("Velocity inner iterations");
         velocity_inner_tolerance = prm.get_double("Velocity inner tolerance");
         where.require(velocity_inner_tolerance < 1,
                       "Linear solver/Velocity inner tolerance",
                       prm.get("Velocity inner tolerance"),
-                      "must lie in [0, 1)");
-        velocity_inner_max_iterations =
-          prm.get_integer("Velocity inner max iterations");
+                      "must be below 1");
       }
       prm.leave_subsection();
 

@@ -5,7 +5,6 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_precondition.h>
 
-#include <string>
 #include <vector>
 
 namespace ImmersedGrains
@@ -17,12 +16,13 @@ namespace ImmersedGrains
    *   [ B  0   ] [p] = [g],           [ 0  -S  ],
    *
    * applied as p = -S~^{-1} g, u = A~^{-1}(f - B^T p). A~^{-1} is one or
-   * more AMG V-cycles on the velocity block. S~^{-1} is the Cahouet-Chabard
-   * sum M_w^{-1} + S_c^{-1} of a pressure mass matrix weighted by phi/mu
-   * (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T, the limit where
-   * mass and drag c = phi rho a0/dt + beta dominate, each approximated by
-   * one application of ILU (mass) or AMG (S_c); either term may be left
-   * out. doc/theory.md motivates the choice.
+   * more AMG V-cycles on the velocity block, or a few Krylov iterations
+   * preconditioned by them (a variable preconditioner: FGMRES outside). S~^{-1}
+   * is the Cahouet-Chabard sum M_w^{-1} + S_c^{-1} of a pressure mass matrix
+   * weighted by phi/mu (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T,
+   * the limit where mass and drag c = phi rho a0/dt + beta dominate, each
+   * approximated by one application of ILU (mass) or AMG (S_c); either term may
+   * be left out. doc/theory.md motivates the choice.
    */
   class BlockSchurPreconditioner
   {
@@ -33,18 +33,11 @@ namespace ImmersedGrains
     {
       unsigned int velocity_cycles = 1;
 
-      // Inner Krylov solve of A (CG if A is symmetric, else GMRES),
-      // preconditioned by the AMG, to this relative tolerance; 0: none,
-      // velocity_cycles V-cycles instead.
-      double       inner_tolerance      = 0;
-      unsigned int inner_max_iterations = 100;
-      bool         symmetric            = true;
-
-      // ML settings of the velocity AMG (experiments; the defaults are
-      // those measured best in doc/benchmarks.md).
-      std::string  smoother_type         = "ILU";
-      unsigned int smoother_sweeps       = 2;
-      double       aggregation_threshold = 0.02;
+      // If positive: A~^{-1} is up to this many GMRES iterations
+      // preconditioned by one V-cycle, stopped early at a relative residual
+      // of inner_tolerance; 0: velocity_cycles V-cycles.
+      unsigned int inner_iterations = 0;
+      double       inner_tolerance  = 1e-6;
 
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
@@ -63,13 +56,6 @@ namespace ImmersedGrains
     void
     vmult(VectorType &dst, const VectorType &src) const;
 
-    /** Inner iterations on A summed over all vmult() calls (0 without an
-     * inner solve). */
-    unsigned int
-    inner_iterations() const
-    {
-      return total_inner_iterations;
-    }
 
   private:
     void
@@ -78,7 +64,6 @@ namespace ImmersedGrains
 
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
     const Settings                                     settings;
-    mutable unsigned int total_inner_iterations = 0;
 
     dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;
