@@ -3,11 +3,14 @@
 // mesh levels, time steps (including steady), drag coefficients
 // (beta h^2/mu) and a fluid fraction that jumps between 0.35 and 1.
 //
-//   fluid_preconditioner DIM LEVEL_MIN LEVEL_MAX [advection] [schur]
+//   fluid_preconditioner DIM LEVEL_MIN LEVEL_MAX [stokes|advection] [schur]
+//                        [AMG cycles] ["Name = value; Name = value"]
 //
 // prints one markdown row per (level, dt, beta) with iterations, solve time
-// per DoF and peak memory. benchmarks/run_fluid_preconditioner.sh makes the
-// tables of doc/benchmarks.md.
+// per DoF and peak memory. The last argument sets further entries of
+// `subsection Fluid/Linear solver`. FLUID_BENCH_DT and FLUID_BENCH_BETA
+// (comma lists, e.g. "1,steady" and "1e8") restrict the cells run.
+// benchmarks/run_fluid_benchmarks.sh makes the tables of doc/benchmarks.md.
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/utilities.h>
@@ -18,7 +21,10 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <string>
+#include <vector>
 
 using namespace dealii;
 using namespace ImmersedGrains;
@@ -74,6 +80,20 @@ public:
   }
 };
 
+// The values of a comma-separated environment variable, or @p all.
+std::vector<double>
+selected(const char *variable, const std::vector<double> &all)
+{
+  const char *text = std::getenv(variable);
+  if (text == nullptr)
+    return all;
+  std::vector<double> values;
+  for (const std::string &entry :
+       Utilities::split_string_list(std::string(text), ','))
+    values.push_back(entry == "steady" ? 0.0 : std::stod(entry));
+  return values;
+}
+
 double
 peak_memory_mib()
 {
@@ -88,16 +108,21 @@ run(const unsigned int level_min,
     const unsigned int level_max,
     const bool         advection,
     const std::string &schur,
-    const unsigned int cycles)
+    const unsigned int cycles,
+    const std::string &extra)
 {
+  std::string extra_entries;
+  for (const std::string &entry : Utilities::split_string_list(extra, ';'))
+    extra_entries += "  set " + entry + "\n";
   const bool root = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
   if (root)
     std::printf(
       "| dim | level | DoFs | dt | beta h^2/mu | iterations | solve s | "
       "s per MDoF | peak MiB |\n|---|---|---|---|---|---|---|---|---|\n");
   for (unsigned int level = level_min; level <= level_max; ++level)
-    for (const double dt : {1e-8, 1e-4, 1.0, 0.0})
-      for (const double beta_scaled : {0.0, 1.0, 1e4, 1e8})
+    for (const double dt : selected("FLUID_BENCH_DT", {1e-8, 1e-4, 1.0, 0.0}))
+      for (const double beta_scaled :
+           selected("FLUID_BENCH_BETA", {0.0, 1.0, 1e4, 1e8}))
       {
         ParameterHandler prm;
         Simulation<dim>::declare_parameters(prm);
@@ -110,7 +135,7 @@ run(const unsigned int level_min,
           "  set Tolerance = 1e-8\n  set Max iterations = 1000\n"
           "  set Schur complement = " +
           schur + "\n  set Velocity AMG cycles = " + std::to_string(cycles) +
-          "\n end\nend\n");
+          "\n" + extra_entries + " end\nend\n");
         Geometry<dim> geometry;
         geometry.parse_parameters(prm, "benchmark");
         geometry.initial_refinement = level;
@@ -165,7 +190,9 @@ run(const unsigned int level_min,
             static_cast<unsigned long long>(fluid.n_dofs()),
             dt_text,
             beta_scaled,
-            converged ? std::to_string(iterations).c_str() : "> 1000",
+            converged ?
+              std::to_string(iterations).c_str() :
+              ("> " + std::to_string(parameters.max_linear_iterations)).c_str(),
             seconds,
             seconds / (fluid.n_dofs() * 1e-6),
             memory);
@@ -183,7 +210,7 @@ main(int argc, char **argv)
     std::cerr << "usage: fluid_preconditioner DIM LEVEL_MIN LEVEL_MAX "
                  "[stokes|advection] [Cahouet-Chabard|pressure mass|pressure "
                  "Laplacian] "
-                 "[AMG cycles]\n";
+                 "[AMG cycles] [\"Name = value; ...\" (Linear solver)]\n";
     return 1;
   }
   const int          dim      = std::atoi(argv[1]);
@@ -192,8 +219,9 @@ main(int argc, char **argv)
   const bool        advection = argc > 4 && std::string(argv[4]) == "advection";
   const std::string schur     = argc > 5 ? argv[5] : "Cahouet-Chabard";
   const unsigned int cycles   = argc > 6 ? std::atoi(argv[6]) : 1;
+  const std::string  extra    = argc > 7 ? argv[7] : "";
   if (dim == 2)
-    run<2>(lmin, lmax, advection, schur, cycles);
+    run<2>(lmin, lmax, advection, schur, cycles, extra);
   else
-    run<3>(lmin, lmax, advection, schur, cycles);
+    run<3>(lmin, lmax, advection, schur, cycles, extra);
 }

@@ -2,7 +2,7 @@
 # Fluid solver benchmarks for doc/benchmarks.md:
 #  1. preconditioner robustness: outer FGMRES iterations over mesh levels,
 #     time steps, drag and a jumping fluid fraction (2D levels 3..7, 3D 2..4;
-#     LARGE=1 adds 3D level 5);
+#     LARGE=1 adds 3D level 5; INNER=1 the inner-GMRES variant);
 #  2. what switching physics off saves: the same scene solved as
 #     Navier-Stokes/BDF2, Stokes/BDF2 and steady Stokes.
 # Usage: benchmarks/run_fluid_benchmarks.sh [OUTDIR]  (after scripts/setup.sh)
@@ -18,6 +18,14 @@ $bin 2 3 7 > "$out/preconditioner_2d.md"
 $bin 3 2 4 > "$out/preconditioner_3d.md"
 if [ "${LARGE:-0}" = 1 ]; then
   $bin 3 5 5 > "$out/preconditioner_3d_level5.md"
+fi
+# INNER=1: the drag-jump columns with the inner GMRES on the velocity block
+# (doc/benchmarks.md, "The drag-jump cells").
+if [ "${INNER:-0}" = 1 ]; then
+  FLUID_BENCH_DT=1,steady FLUID_BENCH_BETA=1e4,1e8 \
+    $bin 2 3 7 stokes Cahouet-Chabard 1 \
+    "Velocity inner iterations = 15; Max iterations = 300" \
+    > "$out/preconditioner_2d_inner.md"
 fi
 
 # Physics switched off: the porous channel scene, 10 steps each.

@@ -9,6 +9,7 @@
 #include <immersed_grains/fluid/block_preconditioner.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
+#include <cstdlib>
 #include <sstream>
 
 namespace ImmersedGrains
@@ -20,7 +21,9 @@ namespace ImmersedGrains
     dealii::TimerOutput::Scope scope(timer, "fluid: preconditioner");
 
     BlockSchurPreconditioner::Settings settings;
-    settings.velocity_cycles = parameters.velocity_amg_cycles;
+    settings.velocity_cycles  = parameters.velocity_amg_cycles;
+    settings.inner_iterations = parameters.velocity_inner_iterations;
+    settings.inner_tolerance  = parameters.velocity_inner_tolerance;
     const dealii::FEValuesExtractors::Vector velocities(0);
     dealii::DoFTools::extract_constant_modes(dof_handler,
                                              fe.component_mask(velocities),
@@ -113,11 +116,14 @@ namespace ImmersedGrains
   namespace
   {
     // Copies a block matrix whose blocks are contiguous ranges of the global
-    // DoF numbering into one matrix, for a sparse direct solver.
+    // DoF numbering into one matrix, for a sparse direct solver. Row
+    // @p pinned (if valid) becomes the identity row: the zero pressure
+    // block has no stored diagonal to overwrite afterwards.
     void
     copy_to_monolithic(
       const dealii::TrilinosWrappers::BlockSparseMatrix &blocks,
-      dealii::TrilinosWrappers::SparseMatrix            &matrix)
+      dealii::TrilinosWrappers::SparseMatrix            &matrix,
+      const dealii::types::global_dof_index              pinned)
     {
       dealii::types::global_dof_index offsets[2] = {0, blocks.block(0, 0).m()};
       for (unsigned int bi = 0; bi < 2; ++bi)
@@ -125,13 +131,20 @@ namespace ImmersedGrains
         {
           const auto &block = blocks.block(bi, bj);
           for (const auto row : block.locally_owned_range_indices())
+          {
+            if (row + offsets[bi] == pinned)
+              continue;
             for (auto entry = block.begin(row); entry != block.end(row);
                  ++entry)
               if (entry->value() != 0)
                 matrix.set(row + offsets[bi],
                            entry->column() + offsets[bj],
                            entry->value());
+          }
         }
+      if (pinned != dealii::numbers::invalid_dof_index &&
+          matrix.locally_owned_range_indices().is_element(pinned))
+        matrix.set(pinned, pinned, 1.0);
       matrix.compress(dealii::VectorOperation::insert);
     }
   } // namespace
@@ -149,30 +162,19 @@ namespace ImmersedGrains
       // path is meant for.
       dealii::TrilinosWrappers::SparseMatrix matrix(
         owned, owned, mpi_communicator, 30 * (dim + 1) * (dim == 3 ? 3 : 1));
-      copy_to_monolithic(system_matrix, matrix);
-      dealii::TrilinosWrappers::MPI::Vector x(owned, mpi_communicator),
-        b(owned, mpi_communicator);
       const dealii::types::global_dof_index n_u = system_matrix.block(0, 0).m();
-      for (unsigned int bi = 0; bi < 2; ++bi)
-        for (const auto i : owned_partitioning[bi])
-          b[i + (bi == 0 ? 0 : n_u)] = system_rhs.block(bi)[i];
-      b.compress(dealii::VectorOperation::insert);
-
       // A singular (pure-Neumann pressure) system has one zero pivot; pin
       // one pressure DoF of the update, the mean is fixed afterwards.
-      if (pressure_has_null_space())
-      {
-        const auto pinned = n_u;
-        if (owned.is_element(pinned))
-        {
-          for (auto entry = matrix.begin(pinned); entry != matrix.end(pinned);
-               ++entry)
-            entry->value() = (entry->column() == pinned) ? 1.0 : 0.0;
-          b[pinned] = 0;
-        }
-        matrix.compress(dealii::VectorOperation::insert);
-        b.compress(dealii::VectorOperation::insert);
-      }
+      const dealii::types::global_dof_index pinned =
+        pressure_has_null_space() ? n_u : dealii::numbers::invalid_dof_index;
+      copy_to_monolithic(system_matrix, matrix, pinned);
+      dealii::TrilinosWrappers::MPI::Vector x(owned, mpi_communicator),
+        b(owned, mpi_communicator);
+      for (unsigned int bi = 0; bi < 2; ++bi)
+        for (const auto i : owned_partitioning[bi])
+          b[i + (bi == 0 ? 0 : n_u)] =
+            (i + (bi == 0 ? 0 : n_u) == pinned) ? 0.0 : system_rhs.block(bi)[i];
+      b.compress(dealii::VectorOperation::insert);
 
       dealii::SolverControl                  control(1, 0);
       dealii::TrilinosWrappers::SolverDirect solver(control);

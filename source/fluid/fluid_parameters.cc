@@ -133,6 +133,19 @@ namespace ImmersedGrains
                           Integer(1, 10),
                           "AMG V-cycles per application of the velocity "
                           "block's inverse.");
+        prm.declare_entry(
+          "Velocity inner iterations",
+          "0",
+          Integer(0, 1000),
+          "0: the velocity block's inverse is Velocity AMG cycles V-cycles "
+          "(cheap; enough up to a drag contrast of about 1e4). N > 0: up to "
+          "N GMRES iterations preconditioned by one V-cycle, for drag "
+          "jumping by many orders of magnitude (doc/benchmarks.md).");
+        prm.declare_entry("Velocity inner tolerance",
+                          "1e-6",
+                          Double(0, 1),
+                          "Relative residual at which the inner iterations "
+                          "stop before Velocity inner iterations.");
       }
       prm.leave_subsection();
 
@@ -190,6 +203,13 @@ namespace ImmersedGrains
                                        SchurApproximation::pressure_laplace :
                                        SchurApproximation::cahouet_chabard);
         velocity_amg_cycles     = prm.get_integer("Velocity AMG cycles");
+        velocity_inner_iterations =
+          prm.get_integer("Velocity inner iterations");
+        velocity_inner_tolerance = prm.get_double("Velocity inner tolerance");
+        where.require(velocity_inner_tolerance < 1,
+                      "Linear solver/Velocity inner tolerance",
+                      prm.get("Velocity inner tolerance"),
+                      "must be below 1");
       }
       prm.leave_subsection();
 

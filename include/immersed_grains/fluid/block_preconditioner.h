@@ -16,12 +16,13 @@ namespace ImmersedGrains
    *   [ B  0   ] [p] = [g],           [ 0  -S  ],
    *
    * applied as p = -S~^{-1} g, u = A~^{-1}(f - B^T p). A~^{-1} is one or
-   * more AMG V-cycles on the velocity block. S~^{-1} is the Cahouet-Chabard
-   * sum M_w^{-1} + S_c^{-1} of a pressure mass matrix weighted by phi/mu
-   * (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T, the limit where
-   * mass and drag c = phi rho a0/dt + beta dominate, each approximated by
-   * one application of ILU (mass) or AMG (S_c); either term may be left
-   * out. doc/theory.md motivates the choice.
+   * more AMG V-cycles on the velocity block, or a few Krylov iterations
+   * preconditioned by them (a variable preconditioner: FGMRES outside). S~^{-1}
+   * is the Cahouet-Chabard sum M_w^{-1} + S_c^{-1} of a pressure mass matrix
+   * weighted by phi/mu (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T,
+   * the limit where mass and drag c = phi rho a0/dt + beta dominate, each
+   * approximated by one application of ILU (mass) or AMG (S_c); either term may
+   * be left out. doc/theory.md motivates the choice.
    */
   class BlockSchurPreconditioner
   {
@@ -31,6 +32,12 @@ namespace ImmersedGrains
     struct Settings
     {
       unsigned int velocity_cycles = 1;
+
+      // If positive: A~^{-1} is up to this many GMRES iterations
+      // preconditioned by one V-cycle, stopped early at a relative residual
+      // of inner_tolerance; 0: velocity_cycles V-cycles.
+      unsigned int inner_iterations = 0;
+      double       inner_tolerance  = 1e-6;
 
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
@@ -49,9 +56,14 @@ namespace ImmersedGrains
     void
     vmult(VectorType &dst, const VectorType &src) const;
 
+
   private:
+    void
+    solve_velocity(dealii::TrilinosWrappers::MPI::Vector       &dst,
+                   const dealii::TrilinosWrappers::MPI::Vector &src) const;
+
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
-    const unsigned int                                 velocity_cycles;
+    const Settings                                     settings;
 
     dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;

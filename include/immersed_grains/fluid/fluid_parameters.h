@@ -50,7 +50,9 @@ namespace ImmersedGrains
     unsigned int       max_linear_iterations = 500;
     SchurApproximation schur_approximation =
       SchurApproximation::cahouet_chabard;
-    unsigned int velocity_amg_cycles = 1;
+    unsigned int velocity_amg_cycles       = 1;
+    unsigned int velocity_inner_iterations = 0;
+    double       velocity_inner_tolerance  = 1e-6;
 
     // Prescribed fields; shared so that a test can substitute exact ones.
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> fluid_fraction;
