@@ -164,6 +164,16 @@ namespace ImmersedGrains
     {
       setup(pairs, wall_contacts, wall_velocities, grain_arrays, time_step);
 
+      if (parameters.method == ContactMethod::apgd)
+      {
+        SolverResult result =
+          iterate_accelerated([]() {}, [](AcceleratedMeasures &) {});
+        finish(grain_arrays);
+        for (const Row &row : rows)
+          result.n_active += (row.p_n > 0);
+        return result;
+      }
+
       SolverResult result;
       result.n_contacts = rows.size();
       if (rows.empty())

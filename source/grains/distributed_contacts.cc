@@ -421,7 +421,39 @@ namespace ImmersedGrains
     glue_copies();
     bool   converged = false;
     double overlap   = 0;
-    while (!converged && result.iterations < prm.max_iterations)
+    if (prm.method == Contact::ContactMethod::apgd)
+    {
+      // One glue and two reductions per iteration: APGD's gradient needs
+      // the velocities of the global iterate.
+      const auto reduce = [&](Contact::AcceleratedMeasures &m)
+      {
+        if (n_ranks == 1)
+          return;
+        const double sums[3]   = {m.curvature, m.metric, m.restart};
+        const double maxima[4] = {m.max_change,
+                                  m.max_impulse,
+                                  m.max_overlap,
+                                  m.overlap_excess};
+        double       s[3], x[4];
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 3),
+                                    comm,
+                                    dealii::ArrayView<double>(s, 3));
+        dealii::Utilities::MPI::max(dealii::ArrayView<const double>(maxima, 4),
+                                    comm,
+                                    dealii::ArrayView<double>(x, 4));
+        m.curvature      = s[0];
+        m.metric         = s[1];
+        m.restart        = s[2];
+        m.max_change     = x[0];
+        m.max_impulse    = x[1];
+        m.max_overlap    = x[2];
+        m.overlap_excess = x[3];
+      };
+      result    = solver.iterate_accelerated([&]() { glue_copies(); }, reduce);
+      converged = result.converged;
+    }
+    while (!converged && result.iterations < prm.max_iterations &&
+           prm.method == Contact::ContactMethod::gauss_seidel)
     {
       // Several local sweeps per exchange: on a rank boundary information
       // then crosses once per batch, but the messages and the reduction,

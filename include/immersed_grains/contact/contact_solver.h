@@ -7,6 +7,8 @@
 #include <immersed_grains/contact/walls.h>
 
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -61,8 +63,22 @@ namespace ImmersedGrains
       std::vector<double> sweep_key;
     };
 
+    /// How ContactSolver::solve() iterates (doc/contacts.md).
+    enum class ContactMethod
+    {
+      /// Projected Gauss-Seidel: contact after contact, velocities updated
+      /// in place.
+      gauss_seidel,
+      /// Nesterov-accelerated projected gradient descent with adaptive step
+      /// and restart (Mazhar, Heyn, Negrut & Tasora, ACM TOG 34(3), 2015),
+      /// preconditioned with the contacts' diagonal Delassus blocks.
+      apgd
+    };
+
     struct ContactParameters
     {
+      ContactMethod method = ContactMethod::gauss_seidel;
+
       /// Newton coefficient of restitution e in [0, 1].
       double restitution = 0;
 
@@ -77,6 +93,8 @@ namespace ImmersedGrains
       /// below this times the smallest radius in contact.
       double overlap_tolerance = 1e-3;
 
+      /// Cap on Gauss-Seidel sweeps, or on APGD iterations (each trial step
+      /// of the step-size search counts).
       unsigned int max_iterations = 1000;
 
       /// Start from last step's impulses, matched by grain ids.
@@ -88,6 +106,28 @@ namespace ImmersedGrains
     {
       double max_change  = 0;
       double max_impulse = 0;
+    };
+
+    /**
+     * Local measures of one APGD trial step (ContactSolver::apgd_measure()),
+     * to be reduced over ranks: curvature, metric and restart by sum, the
+     * others by max.
+     */
+    struct AcceleratedMeasures
+    {
+      /// d.N d and d.D d for the step d = p_new - y (step-size test).
+      double curvature = 0;
+      double metric    = 0;
+      /// grad f(y).(p_new - p): > 0 restarts the momentum.
+      double restart = 0;
+      /// Largest change one projected Jacobi step would make at p_new, and
+      /// the largest impulse |p_new|: the residual of the convergence test.
+      double max_change  = 0;
+      double max_impulse = 0;
+      /// Largest overlap predicted at p_new [m], and the same less the
+      /// local overlap limit (converged only if <= 0 on every rank).
+      double max_overlap    = 0;
+      double overlap_excess = -std::numeric_limits<double>::max();
     };
 
     struct SolverResult
@@ -190,6 +230,19 @@ namespace ImmersedGrains
       bool
       converged(const SweepResult &sweep, const double max_overlap) const;
 
+      /**
+       * The APGD iterations (ContactMethod::apgd) after setup(): each
+       * trial step updates the working velocities locally, then @p glue
+       * must make all copies of a grain agree (a no-op in serial), and
+       * @p reduce must reduce the AcceleratedMeasures over all ranks (sums
+       * and maxima as documented there). All ranks take the
+       * same decisions and stop together. Call finish() afterwards.
+       */
+      SolverResult
+      iterate_accelerated(
+        const std::function<void()>                      &glue,
+        const std::function<void(AcceleratedMeasures &)> &reduce);
+
       /// Writes the working velocities into @p grains, fills the impulse
       /// lists and keeps the impulses for the next warm start.
       void
@@ -276,6 +329,19 @@ namespace ImmersedGrains
 
       std::vector<CachedImpulse> cache;
 
+      // APGD state per contact, c = 1 (normal) or dim (impulse vector
+      // p_n n + p_t) values per contact: the previous iterate, the trial,
+      // and the relative (contact point) velocities of the accepted, the
+      // previous and the trial iterate. The accepted impulses are those of
+      // rows/friction_rows; the velocities of the accepted iterate are
+      // kept in accepted_grains/accepted_spins to undo a rejected trial.
+      std::vector<double>    p_old, p_new, u, u_old, u_new;
+      std::vector<GrainSlot> accepted_grains;
+      std::vector<SpinSlot>  accepted_spins;
+      double                 lipschitz = 1; // L: the step is 1/L
+      double                 theta     = 1;
+      double                 momentum  = 0; // beta: y = p + beta (p - p_old)
+
       // Contact m of the lists given to setup() (pairs, then walls) is row
       // row_of_input[m] of the work arrays, which are in sweep order.
       std::vector<unsigned int>                    row_of_input;
@@ -310,6 +376,26 @@ namespace ImmersedGrains
       template <bool with_friction>
       SweepResult
       sweep_rows();
+
+      // APGD (source/contact/accelerated_solver.cc).
+      template <bool with_friction>
+      void
+      apgd_start();
+
+      template <bool with_friction>
+      void
+      apgd_trial();
+
+      template <bool with_friction>
+      AcceleratedMeasures
+      apgd_measure();
+
+      bool
+      apgd_accept(const AcceleratedMeasures &global);
+
+      template <bool with_friction>
+      void
+      contact_velocity(const unsigned int k, double *out) const;
     };
   } // namespace Contact
 } // namespace ImmersedGrains

@@ -42,7 +42,11 @@ namespace ImmersedGrains
    *    every contact law and the true equation of motion hold, as in serial;
    *  - convergence is decided on the maxima over all ranks, so all ranks
    *    sweep the same number of times; ranks exchange after every few
-   *    local sweeps (sweeps_per_exchange), not after each.
+   *    local sweeps (sweeps_per_exchange), not after each;
+   *  - with Contacts/Solver = apgd the copies are glued after every
+   *    iteration (its gradient needs the global iterate's velocities) and
+   *    the step-size, restart and convergence measures are reduced, so all
+   *    ranks iterate as the serial solver does.
    * On one rank this is the serial solver without any copying.
    */
   template <int dim>
