@@ -46,6 +46,16 @@ namespace ImmersedGrains
         "that part grows as cells shrink towards the grain size "
         "(doc/validation.md), with 'filtered' it is set by the length in "
         "metres and does not depend on the mesh.");
+      prm.declare_entry(
+        "Implicit coupling",
+        "true",
+        Bool(),
+        "The grains' new velocities, eliminated into the fluid solve: the "
+        "pressure-gradient force on them (-V grad p) and their volume flux "
+        "in the mixture continuity at the new time level (doc/theory.md 3). "
+        "Keeps dense beds and suspensions stable with time steps far above "
+        "their relaxation time. false: both from the previous step (stable "
+        "only for dilute suspensions or short steps).");
       SolidFraction<dim>::Parameters::declare_parameters(prm);
     }
     prm.leave_subsection();
@@ -63,6 +73,7 @@ namespace ImmersedGrains
       tracers           = prm.get_bool("Tracers");
       two_way           = prm.get_bool("Two-way") && !tracers;
       drag_distribution = prm.get("Drag distribution");
+      implicit_coupling = prm.get_bool("Implicit coupling");
       projection.parse_parameters(prm, file);
     }
     prm.leave_subsection();
@@ -89,9 +100,14 @@ namespace ImmersedGrains
                                                         tria))
       , drag_law(DragLaw::create(parameters.drag_law))
   {
-    if (parameters.drag_distribution == "filtered")
+    if (parameters.drag_distribution == "filtered" ||
+        (parameters.two_way && parameters.implicit_coupling))
       filtered_drag = std::make_unique<FilteredDrag<dim>>(
-        tria, geometry, parameters.projection.smoothing_length);
+        tria,
+        geometry,
+        parameters.projection.smoothing_length,
+        parameters.drag_distribution == "filtered",
+        parameters.two_way && parameters.implicit_coupling);
   }
 
 
@@ -114,7 +130,7 @@ namespace ImmersedGrains
     // The simulation owns both; the fluid only borrows this object.
     fluid.set_mixture_fields(std::shared_ptr<const MixtureFields<dim>>(
       this, [](const MixtureFields<dim> *) {}));
-    if (!filtered_drag)
+    if (!drag_as_field())
       fluid.set_point_drag_source(std::shared_ptr<const PointDragSource<dim>>(
                                     this, [](const PointDragSource<dim> *) {}),
                                   parameters.drag_distribution == "cell");
@@ -143,7 +159,7 @@ namespace ImmersedGrains
     const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
     const std::vector<dealii::Point<dim>> &references) const
   {
-    if (filtered_drag)
+    if (drag_as_field())
       return filtered_drag->filtered_velocity(cell, references);
     const auto values = fluid.point_values(cell, references);
     std::vector<dealii::Tensor<1, dim>> result(values.size());
@@ -231,9 +247,11 @@ namespace ImmersedGrains
     cell_drags.assign(triangulation.n_active_cells(), {});
     reynolds_max = 0;
 
-    if (filtered_drag)
+    if (drag_as_field())
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
                                      fluid.get_solution());
+    const bool implicit_velocity =
+      parameters.two_way && parameters.implicit_coupling;
     const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
     MixtureValues<dim>              mixture;
@@ -252,8 +270,9 @@ namespace ImmersedGrains
           const double       V = grain_volume<dim>(r);
           // The seed's interaction force without drag: gravity minus
           // buoyancy (m g comes from Grains) and the dynamic pressure.
-          lagged_force[i] =
-            -density * V * g - V * fluid_values[k].pressure_gradient;
+          lagged_force[i] = -density * V * g;
+          if (!implicit_velocity)
+            lagged_force[i] -= V * fluid_values[k].pressure_gradient;
           const dealii::Tensor<1, dim> slip = c.velocity[i] - felt[k];
           const DragInput              in{r,
                              projected_area<dim>(r),
@@ -283,6 +302,15 @@ namespace ImmersedGrains
             // on each other (P = -dt m g') leave the fluid undisturbed.
             if (!arrays.contact_impulse.empty())
               drag.velocity += arrays.contact_impulse[i] / m;
+            if (implicit_velocity)
+            {
+              // The grain's new velocity is (m v~ + dt gamma u - dt V grad
+              // p) / (m + dt gamma): theta of it follows the fluid.
+              const double theta     = dt * gamma[i] / (m + dt * gamma[i]);
+              drag.pressure_weight   = V * theta;
+              drag.pressure_mobility = dt * V * V / (m + dt * gamma[i]);
+              drag.free_flux         = V * (1 - theta) * drag.velocity;
+            }
           }
           cell_drags[cell->active_cell_index()].push_back(drag);
         }
@@ -290,7 +318,7 @@ namespace ImmersedGrains
     reynolds_max =
       dealii::Utilities::MPI::max(reynolds_max,
                                   triangulation.get_communicator());
-    if (filtered_drag && parameters.two_way)
+    if (filtered_drag)
       filtered_drag->spread(
         [&](const auto &cell, std::vector<PointDrag<dim>> &drags)
         { drags = cell_drags[cell->active_cell_index()]; });
@@ -310,9 +338,11 @@ namespace ImmersedGrains
     arrays.drag_coefficient.resize(n);
     arrays.drag_velocity.resize(n);
 
-    if (filtered_drag)
+    if (drag_as_field())
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
                                      fluid.get_solution());
+    const bool implicit_velocity =
+      parameters.two_way && parameters.implicit_coupling;
     std::vector<dealii::Point<dim>> references;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
@@ -320,6 +350,16 @@ namespace ImmersedGrains
       [&](const auto &cell, const unsigned int first, const unsigned int end)
       {
         const auto felt = felt_velocity(fluid, cell, references);
+        // The new pressure gradient, as the fluid solve assumed: filtered
+        // with the drag as a field (the adjoint of spreading alpha), else
+        // at the centre.
+        std::vector<dealii::Tensor<1, dim>> pressure_gradient;
+        if (implicit_velocity && drag_as_field())
+          pressure_gradient =
+            filtered_drag->filtered_pressure_gradient(cell, references);
+        else if (implicit_velocity)
+          for (const auto &v : fluid.point_values(cell, references))
+            pressure_gradient.push_back(v.pressure_gradient);
         for (unsigned int i = first; i < end; ++i)
         {
           const auto &u           = felt[i - first];
@@ -333,7 +373,11 @@ namespace ImmersedGrains
             arrays.drag_coefficient[i] = 1e12 * arrays.mass[i] / dt;
             continue;
           }
-          arrays.external_force[i]   = lagged_force[i];
+          arrays.external_force[i] = lagged_force[i];
+          if (implicit_velocity)
+            arrays.external_force[i] -=
+              grain_volume<dim>(arrays.contact.radius[i]) *
+              pressure_gradient[i - first];
           arrays.drag_coefficient[i] = gamma[i];
         }
       });
@@ -363,9 +407,10 @@ namespace ImmersedGrains
     if (filtered_drag)
       on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
                                                fluid.get_solution());
-    else
+    if (!drag_as_field())
     {
       // The point drags through the fluid velocity the grains felt.
+      dealii::Tensor<1, dim>          point_force;
       std::vector<dealii::Point<dim>> references;
       for_each_cell_batch<dim>(
         grains.particle_handler(),
@@ -375,9 +420,9 @@ namespace ImmersedGrains
           const auto  felt  = felt_velocity(fluid, cell, references);
           const auto &drags = cell_drags[cell->active_cell_index()];
           for (unsigned int k = 0; k < drags.size(); ++k)
-            on_fluid -= drags[k].beta * (felt[k] - drags[k].velocity);
+            point_force -= drags[k].beta * (felt[k] - drags[k].velocity);
         });
-      on_fluid = dealii::Utilities::MPI::sum(on_fluid, comm);
+      on_fluid += dealii::Utilities::MPI::sum(point_force, comm);
     }
     // The drag in the grains' implicit update, with their final velocity.
     const auto &arrays = const_cast<Grains<dim> &>(grains).step_arrays();

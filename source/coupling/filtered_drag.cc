@@ -10,9 +10,13 @@ namespace ImmersedGrains
   FilteredDrag<dim>::FilteredDrag(
     const dealii::parallel::distributed::Triangulation<dim> &tria,
     const Geometry<dim>                                     &geometry,
-    const double                                             length)
+    const double                                             length,
+    const bool                                               drag_as_field,
+    const bool                                               implicit_velocity)
       : filter(tria, geometry)
       , length(length)
+      , drag_as_field(drag_as_field)
+      , implicit_velocity(implicit_velocity)
   {
   }
 
@@ -23,11 +27,15 @@ namespace ImmersedGrains
   {
     // Lumped: an M-matrix, so beta_h >= 0 wherever grains are.
     filter.setup(true, length);
-    beta = filter.make_ghosted_vector();
+    beta     = filter.make_ghosted_vector();
+    alpha    = filter.make_ghosted_vector();
+    mobility = filter.make_ghosted_vector();
     for (unsigned int d = 0; d < dim; ++d)
     {
-      momentum[d] = filter.make_ghosted_vector();
-      velocity[d] = filter.make_ghosted_vector();
+      free_flux[d]         = filter.make_ghosted_vector();
+      momentum[d]          = filter.make_ghosted_vector();
+      velocity[d]          = filter.make_ghosted_vector();
+      pressure_gradient[d] = filter.make_ghosted_vector();
     }
   }
 
@@ -39,7 +47,12 @@ namespace ImmersedGrains
       void(const typename dealii::Triangulation<dim>::active_cell_iterator &,
            std::vector<PointDrag<dim>> &)> &drags)
   {
-    auto beta_rhs = filter.make_owned_vector();
+    auto beta_rhs     = filter.make_owned_vector();
+    auto alpha_rhs    = filter.make_owned_vector();
+    auto mobility_rhs = filter.make_owned_vector();
+    std::array<typename HelmholtzFilter<dim>::Vector, dim> flux_rhs;
+    for (auto &f : flux_rhs)
+      f = filter.make_owned_vector();
     std::array<typename HelmholtzFilter<dim>::Vector, dim> momentum_rhs;
     for (auto &m : momentum_rhs)
       m = filter.make_owned_vector();
@@ -48,8 +61,11 @@ namespace ImmersedGrains
     const unsigned int                           n  = fe.n_dofs_per_cell();
     std::vector<dealii::types::global_dof_index> indices(n);
     std::vector<PointDrag<dim>>                  cell_drags;
-    dealii::Vector<double>                       cell_beta(n);
-    std::array<dealii::Vector<double>, dim>      cell_momentum;
+    dealii::Vector<double> cell_beta(n), cell_alpha(n), cell_mobility(n);
+    std::array<dealii::Vector<double>, dim> cell_flux;
+    for (auto &f : cell_flux)
+      f.reinit(n);
+    std::array<dealii::Vector<double>, dim> cell_momentum;
     for (auto &m : cell_momentum)
       m.reinit(n);
 
@@ -60,7 +76,11 @@ namespace ImmersedGrains
         drags(cell, cell_drags);
         if (cell_drags.empty())
           continue;
-        cell_beta = 0;
+        cell_beta     = 0;
+        cell_alpha    = 0;
+        cell_mobility = 0;
+        for (auto &f : cell_flux)
+          f = 0;
         for (auto &m : cell_momentum)
           m = 0;
         for (const auto &drag : cell_drags)
@@ -68,10 +88,24 @@ namespace ImmersedGrains
           {
             const double N = fe.shape_value(j, drag.reference_location);
             cell_beta(j) += drag.beta * N;
+            cell_alpha(j) += drag.pressure_weight * N;
+            cell_mobility(j) += drag.pressure_mobility * N;
+            for (unsigned int d = 0; d < dim; ++d)
+              cell_flux[d](j) += drag.free_flux[d] * N;
             for (unsigned int d = 0; d < dim; ++d)
               cell_momentum[d](j) += drag.beta * drag.velocity[d] * N;
           }
         filter.add_cell_contribution(cell, cell_beta, indices, beta_rhs);
+        filter.add_cell_contribution(cell, cell_alpha, indices, alpha_rhs);
+        filter.add_cell_contribution(cell,
+                                     cell_mobility,
+                                     indices,
+                                     mobility_rhs);
+        for (unsigned int d = 0; d < dim; ++d)
+          filter.add_cell_contribution(cell,
+                                       cell_flux[d],
+                                       indices,
+                                       flux_rhs[d]);
         for (unsigned int d = 0; d < dim; ++d)
           filter.add_cell_contribution(cell,
                                        cell_momentum[d],
@@ -79,9 +113,22 @@ namespace ImmersedGrains
                                        momentum_rhs[d]);
       }
     beta_rhs.compress(dealii::VectorOperation::add);
+    alpha_rhs.compress(dealii::VectorOperation::add);
+    mobility_rhs.compress(dealii::VectorOperation::add);
+    for (auto &f : flux_rhs)
+      f.compress(dealii::VectorOperation::add);
     for (auto &m : momentum_rhs)
       m.compress(dealii::VectorOperation::add);
 
+    if (implicit_velocity)
+    {
+      filter.solve(alpha_rhs, alpha);
+      filter.solve(mobility_rhs, mobility);
+      for (unsigned int d = 0; d < dim; ++d)
+        filter.solve(flux_rhs[d], free_flux[d]);
+    }
+    if (!drag_as_field)
+      return;
     filter.solve(beta_rhs, beta);
     for (unsigned int d = 0; d < dim; ++d)
       filter.solve(momentum_rhs[d], momentum[d]);
@@ -89,30 +136,32 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  template <typename Quantity>
   void
-  FilteredDrag<dim>::filter_velocity(
-    const dealii::DoFHandler<dim>                    &fluid_dof_handler,
-    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution)
+  FilteredDrag<dim>::filter_quantity(
+    const dealii::DoFHandler<dim>                          &fluid_dof_handler,
+    const Quantity                                         &quantity,
+    std::array<typename HelmholtzFilter<dim>::Vector, dim> &result)
   {
     std::array<typename HelmholtzFilter<dim>::Vector, dim> rhs;
     for (auto &r : rhs)
       r = filter.make_owned_vector();
 
     // Q1 x Q2 is integrated exactly by the fluid's own Gauss rule.
-    const auto               &fluid_fe = fluid_dof_handler.get_fe();
-    const dealii::QGauss<dim> quadrature(fluid_fe.degree + 1);
-    dealii::FEValues<dim>     fluid_values(filter.get_mapping(),
+    const auto                         &fluid_fe = fluid_dof_handler.get_fe();
+    const dealii::QGauss<dim>           quadrature(fluid_fe.degree + 1);
+    dealii::FEValues<dim>               fluid_values(filter.get_mapping(),
                                        fluid_fe,
                                        quadrature,
                                        dealii::update_values |
+                                         dealii::update_gradients |
                                          dealii::update_JxW_values);
-    dealii::FEValues<dim>     filter_values(filter.get_mapping(),
+    dealii::FEValues<dim>               filter_values(filter.get_mapping(),
                                         filter.get_fe(),
                                         quadrature,
                                         dealii::update_values);
-    const dealii::FEValuesExtractors::Vector velocities(0);
-    std::vector<dealii::Tensor<1, dim>>      u(quadrature.size());
-    const unsigned int n = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::Tensor<1, dim>> values(quadrature.size());
+    const unsigned int                  n = filter.get_fe().n_dofs_per_cell();
     std::array<dealii::Vector<double>, dim>      local;
     std::vector<dealii::types::global_dof_index> indices(n);
     for (auto &l : local)
@@ -124,7 +173,7 @@ namespace ImmersedGrains
         fluid_values.reinit(cell);
         const auto filter_cell = filter.dof_cell(cell);
         filter_values.reinit(filter_cell);
-        fluid_values[velocities].get_function_values(fluid_solution, u);
+        quantity(fluid_values, values);
         for (auto &l : local)
           l = 0;
         for (unsigned int q = 0; q < quadrature.size(); ++q)
@@ -133,7 +182,7 @@ namespace ImmersedGrains
             const double weight =
               filter_values.shape_value(j, q) * fluid_values.JxW(q);
             for (unsigned int d = 0; d < dim; ++d)
-              local[d](j) += u[q][d] * weight;
+              local[d](j) += values[q][d] * weight;
           }
         for (unsigned int d = 0; d < dim; ++d)
           filter.add_cell_contribution(filter_cell, local[d], indices, rhs[d]);
@@ -141,8 +190,32 @@ namespace ImmersedGrains
     for (unsigned int d = 0; d < dim; ++d)
     {
       rhs[d].compress(dealii::VectorOperation::add);
-      filter.solve(rhs[d], velocity[d]);
+      filter.solve(rhs[d], result[d]);
     }
+  }
+
+
+  template <int dim>
+  void
+  FilteredDrag<dim>::filter_velocity(
+    const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution)
+  {
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    const dealii::FEValuesExtractors::Scalar pressure(dim);
+    filter_quantity(
+      fluid_dof_handler,
+      [&](const dealii::FEValues<dim>         &fe_values,
+          std::vector<dealii::Tensor<1, dim>> &values)
+      { fe_values[velocities].get_function_values(fluid_solution, values); },
+      velocity);
+    if (drag_as_field)
+      filter_quantity(
+        fluid_dof_handler,
+        [&](const dealii::FEValues<dim>         &fe_values,
+            std::vector<dealii::Tensor<1, dim>> &values)
+        { fe_values[pressure].get_function_gradients(fluid_solution, values); },
+        pressure_gradient);
   }
 
 
@@ -182,13 +255,14 @@ namespace ImmersedGrains
 
   template <int dim>
   std::vector<dealii::Tensor<1, dim>>
-  FilteredDrag<dim>::filtered_velocity(
+  FilteredDrag<dim>::vector_values(
     const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
-    const std::vector<dealii::Point<dim>> &reference_points) const
+    const std::vector<dealii::Point<dim>> &reference_points,
+    const std::array<typename HelmholtzFilter<dim>::Vector, dim> &field) const
   {
     std::array<const typename HelmholtzFilter<dim>::Vector *, dim> fields;
     for (unsigned int d = 0; d < dim; ++d)
-      fields[d] = &velocity[d];
+      fields[d] = &field[d];
     const auto values = values_at(cell, reference_points, fields);
     std::vector<dealii::Tensor<1, dim>> result(reference_points.size());
     for (unsigned int q = 0; q < result.size(); ++q)
@@ -199,12 +273,51 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::vector<dealii::Tensor<1, dim>>
+  FilteredDrag<dim>::filtered_velocity(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const std::vector<dealii::Point<dim>> &reference_points) const
+  {
+    return vector_values(cell, reference_points, velocity);
+  }
+
+
+  template <int dim>
+  std::vector<dealii::Tensor<1, dim>>
+  FilteredDrag<dim>::filtered_pressure_gradient(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const std::vector<dealii::Point<dim>> &reference_points) const
+  {
+    return vector_values(cell, reference_points, pressure_gradient);
+  }
+
+
+  template <int dim>
   void
   FilteredDrag<dim>::evaluate(
     const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
     const std::vector<dealii::Point<dim>> &reference_points,
     MixtureValues<dim>                    &values) const
   {
+    if (implicit_velocity)
+    {
+      std::array<const typename HelmholtzFilter<dim>::Vector *, dim + 2>
+        implicit_fields;
+      implicit_fields[0] = &alpha;
+      implicit_fields[1] = &mobility;
+      for (unsigned int d = 0; d < dim; ++d)
+        implicit_fields[d + 2] = &free_flux[d];
+      const auto v = values_at(cell, reference_points, implicit_fields);
+      for (unsigned int q = 0; q < reference_points.size(); ++q)
+      {
+        values.pressure_gradient_weight[q] = v[0][q];
+        values.pressure_mobility[q]        = v[1][q];
+        for (unsigned int d = 0; d < dim; ++d)
+          values.solid_flux[q][d] = v[d + 2][q];
+      }
+    }
+    if (!drag_as_field)
+      return;
     std::array<const typename HelmholtzFilter<dim>::Vector *, dim + 1> fields;
     fields[0] = &beta;
     for (unsigned int d = 0; d < dim; ++d)
@@ -232,15 +345,18 @@ namespace ImmersedGrains
                                        fluid_fe,
                                        quadrature,
                                        dealii::update_values |
+                                         dealii::update_gradients |
                                          dealii::update_JxW_values);
     dealii::FEValues<dim>     filter_values(filter.get_mapping(),
                                         filter.get_fe(),
                                         quadrature,
                                         dealii::update_values);
     const dealii::FEValuesExtractors::Vector velocities(0);
+    const dealii::FEValuesExtractors::Scalar pressure(dim);
     std::vector<dealii::Tensor<1, dim>>      u(quadrature.size());
-    std::vector<double>                      b(quadrature.size());
-    std::array<std::vector<double>, dim>     m;
+    std::vector<dealii::Tensor<1, dim>>      grad_p(quadrature.size());
+    std::vector<double> b(quadrature.size()), a(quadrature.size());
+    std::array<std::vector<double>, dim> m;
     for (auto &v : m)
       v.resize(quadrature.size());
     dealii::Tensor<1, dim> force;
@@ -249,6 +365,12 @@ namespace ImmersedGrains
       {
         fluid_values.reinit(cell);
         filter_values.reinit(filter.dof_cell(cell));
+        fluid_values[pressure].get_function_gradients(fluid_solution, grad_p);
+        filter_values.get_function_values(alpha, a);
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          force -= a[q] * grad_p[q] * fluid_values.JxW(q);
+        if (!drag_as_field)
+          continue;
         fluid_values[velocities].get_function_values(fluid_solution, u);
         filter_values.get_function_values(beta, b);
         for (unsigned int d = 0; d < dim; ++d)

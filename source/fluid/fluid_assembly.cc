@@ -79,6 +79,7 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> u(n_q), u_old(n_q), u_older(n_q);
     std::vector<dealii::Tensor<2, dim>> grad_u(n_q);
     std::vector<double>                 p(n_q);
+    std::vector<dealii::Tensor<1, dim>> grad_p(n_q);
     std::vector<dealii::Vector<double>> f(n_q, dealii::Vector<double>(dim));
     MixtureValues<dim>                  mixture;
 
@@ -125,6 +126,7 @@ namespace ImmersedGrains
       fe_values[velocities].get_function_values(solution, u);
       fe_values[velocities].get_function_gradients(solution, grad_u);
       fe_values[pressure].get_function_values(solution, p);
+      fe_values[pressure].get_function_gradients(solution, grad_p);
       if (inv_dt > 0)
       {
         fe_values[velocities].get_function_values(old_solution, u_old);
@@ -137,6 +139,8 @@ namespace ImmersedGrains
         const double phi      = mixture.fluid_fraction[q];
         const auto  &grad_phi = mixture.fluid_fraction_gradient[q];
         const double beta     = mixture.drag_coefficient[q];
+        const double alpha    = mixture.pressure_gradient_weight[q];
+        const double mobility = mixture.pressure_mobility[q];
         const double mass     = phi * rho * bdf[0] * inv_dt;
         const double JxW      = fe_values.JxW(q);
 
@@ -153,7 +157,7 @@ namespace ImmersedGrains
         dealii::Tensor<1, dim> momentum =
           phi * rho * inv_dt *
             (bdf[0] * u[q] + bdf[1] * u_old[q] + bdf[2] * u_older[q]) +
-          beta * (u[q] - mixture.grain_velocity[q]);
+          beta * (u[q] - mixture.grain_velocity[q]) + alpha * grad_p[q];
         if (advection)
           momentum += phi * rho * (grad_u[q] * u[q]);
         for (unsigned int d = 0; d < dim; ++d)
@@ -165,7 +169,8 @@ namespace ImmersedGrains
         // fixed only up to a constant.
         const double continuity = phi * dealii::trace(grad_u[q]) +
                                   grad_phi * u[q] - mixture.mass_source[q];
-        const dealii::Tensor<1, dim> &solid_flux = mixture.solid_flux[q];
+        const dealii::Tensor<1, dim> solid_flux =
+          mixture.solid_flux[q] + alpha * u[q] - mobility * grad_p[q];
 
         for (unsigned int i = 0; i < dofs_per_cell; ++i)
         {
@@ -189,7 +194,9 @@ namespace ImmersedGrains
             cell_matrix(i, j) +=
               (a * phi_u[i] +
                phi * mu * dealii::scalar_product(grad_phi_u[j], grad_phi_u[i]) -
-               phi_p[j] * div_phi_v - phi_p[i] * div_phi_uj) *
+               phi_p[j] * div_phi_v - phi_p[i] * div_phi_uj +
+               alpha * (grad_phi_p[j] * phi_u[i] + grad_phi_p[i] * phi_u[j]) -
+               mobility * (grad_phi_p[i] * grad_phi_p[j])) *
               JxW;
           }
         }

@@ -94,6 +94,17 @@ namespace ImmersedGrains
           }
         }
       schur_diagonal_matrix.compress(dealii::VectorOperation::insert);
+      // The pressure block -C (the grains' pressure mobility, zero without
+      // grains) belongs to the Schur complement C + B A^-1 B^T; its pattern
+      // lies within the product's.
+      const auto &pressure_block = system_matrix.block(1, 1);
+      for (const auto i : owned_partitioning[1])
+        for (auto entry = pressure_block.begin(i);
+             entry != pressure_block.end(i);
+             ++entry)
+          if (entry->value() != 0)
+            schur_diagonal_matrix.add(i, entry->column(), -entry->value());
+      schur_diagonal_matrix.compress(dealii::VectorOperation::add);
       mean = dealii::Utilities::MPI::sum(mean, mpi_communicator) /
              std::max(1u, dealii::Utilities::MPI::sum(n, mpi_communicator));
       const double shift = pressure_has_null_space() ? 1e-6 * mean : 0.0;

@@ -241,8 +241,9 @@ namespace ImmersedGrains
 
     make_constraints();
 
-    // The system couples everything but pressure with pressure; the
-    // preconditioner's pressure mass matrix only pressure with pressure.
+    // The system couples everything (pressure with pressure through the
+    // grains' pressure mobility, doc/theory.md 3); the preconditioner's
+    // pressure mass matrix only pressure with pressure.
     const auto make_matrix =
       [&](const bool                               pressure_only,
           const dealii::AffineConstraints<double> &constraints,
@@ -251,7 +252,7 @@ namespace ImmersedGrains
       dealii::Table<2, dealii::DoFTools::Coupling> coupling(dim + 1, dim + 1);
       for (unsigned int c = 0; c < dim + 1; ++c)
         for (unsigned int d = 0; d < dim + 1; ++d)
-          coupling[c][d] = ((c == dim && d == dim) == pressure_only) ?
+          coupling[c][d] = (!pressure_only || (c == dim && d == dim)) ?
                              dealii::DoFTools::always :
                              dealii::DoFTools::none;
       dealii::TrilinosWrappers::BlockSparsityPattern sp(owned_partitioning,

@@ -12,6 +12,8 @@ namespace ImmersedGrains
     grain_velocity.resize(n);
     solid_flux.resize(n);
     mass_source.resize(n);
+    pressure_gradient_weight.assign(n, 0.0);
+    pressure_mobility.assign(n, 0.0);
   }
 
 

@@ -27,17 +27,21 @@ namespace ImmersedGrains
    * seed's hybrid model, doc/theory.md section 3). Per time step:
    *
    *  1. project(): the solid fraction and the solid flux from the grains;
-   *  2. prepare_fluid_drag(dt): for each grain the interaction force with
-   *     the lagged pressure gradient, F_i = (m_i - rho V_i) g - V_i grad p,
-   *     the drag coefficient gamma_i = gamma(phi, |w|) of the chosen law
-   *     with the lagged slip, and the point drag the fluid sees once the
-   *     grain's implicit update is eliminated:
-   *       beta_i = gamma_i m_i / (m_i + dt gamma_i),  v~_i = v_i + dt F_i/m_i;
-   *  3. (the fluid solves with these point drags)
-   *  4. set_grain_forces(): the grains' hooks get -rho V_i g - V_i grad p,
-   *     gamma_i and the new u(x_i); their implicit update
-   *       v' = (m v + dt (m g + F + gamma u)) / (m + dt gamma)
-   *     then exchanges exactly the momentum the fluid received.
+   *  2. prepare_fluid_drag(dt): for each grain the interaction force
+   *     without drag, F_i = (m_i - rho V_i) g (- V_i grad p^n with
+   *     Implicit coupling = false), the drag coefficient gamma_i of the
+   *     chosen law with the lagged slip, and what the fluid sees once the
+   *     grain's implicit update is eliminated: the point drag
+   *       beta_i = gamma_i m_i / (m_i + dt gamma_i),
+   *       v~_i = v_i + dt F_i/m_i + P_i/m_i (last contact impulse),
+   *     and with the implicit coupling the grain's share of the pressure
+   *     gradient and of the solid flux (FilteredDrag);
+   *  3. (the fluid solves with these)
+   *  4. set_grain_forces(): the grains' hooks get -rho V_i g - V_i grad p
+   *     (new p), gamma_i and the fluid velocity they feel; their implicit
+   *     update v' = (m v + dt (m g + F + gamma u)) / (m + dt gamma) then
+   *     exchanges the momentum the fluid received (exactly with
+   *     Drag distribution = filtered; momentum_exchange_error).
    *
    * With Two-way = false the fluid sees neither the solid fraction nor the
    * drag (one-way coupling); with Tracers = true the grains take the fluid
@@ -58,6 +62,7 @@ namespace ImmersedGrains
       bool                                    two_way  = true;
       bool                                    tracers  = false;
       std::string                             drag_distribution = "cell";
+      bool                                    implicit_coupling = true;
       typename SolidFraction<dim>::Parameters projection;
     };
 
@@ -140,6 +145,12 @@ namespace ImmersedGrains
     std::shared_ptr<SolidFraction<dim>> projection;
     std::unique_ptr<FilteredDrag<dim>>  filtered_drag; // only if chosen
     std::unique_ptr<DragLaw>            drag_law;
+
+    bool
+    drag_as_field() const
+    {
+      return parameters.drag_distribution == "filtered";
+    }
 
     // The fluid velocity a grain feels: at its centre, the cell mean or
     // the filtered velocity, by Drag distribution.

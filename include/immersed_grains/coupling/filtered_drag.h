@@ -26,7 +26,14 @@ namespace ImmersedGrains
    * fluid exchange the same momentum to round-off, and since the filter
    * acts over the physical length l instead of a cell, what a grain feels
    * of its own disturbance no longer depends on the mesh (doc/theory.md
-   * section 3.4).
+   * section 3).
+   *
+   * With the grains' new velocity eliminated into the fluid solve
+   * (@p implicit_velocity, doc/theory.md 3), the weights alpha_i, the
+   * mobilities k_i and the free fluxes of PointDrag are spread the same
+   * way: the fluid's momentum equation gains alpha_h grad p and the solid
+   * flux becomes s_h + alpha_h u - k_h grad p. That part is used with
+   * every Drag distribution (@p drag_as_field false: only it).
    */
   template <int dim>
   class FilteredDrag
@@ -34,7 +41,9 @@ namespace ImmersedGrains
   public:
     FilteredDrag(const dealii::parallel::distributed::Triangulation<dim> &tria,
                  const Geometry<dim> &geometry,
-                 double               length);
+                 double               length,
+                 bool                 drag_as_field,
+                 bool                 implicit_velocity);
 
     /** After every mesh change. */
     void
@@ -46,7 +55,8 @@ namespace ImmersedGrains
              const typename dealii::Triangulation<dim>::active_cell_iterator &,
              std::vector<PointDrag<dim>> &)> &drags);
 
-    /** Filters the velocity of a Q2^dim-Q1 fluid solution. */
+    /** Filters the velocity (and, with the drag as a field, the pressure
+     * gradient) of a Q2^dim-Q1 fluid solution. */
     void
     filter_velocity(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
@@ -58,16 +68,23 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>> &reference_points) const;
 
-    /** Sets the drag coefficient beta_h and the velocity m_h / beta_h. */
+    /** The filtered pressure gradient at points of a cell. */
+    std::vector<dealii::Tensor<1, dim>>
+    filtered_pressure_gradient(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &reference_points) const;
+
+    /** Sets alpha_h, and with the drag as a field the drag coefficient
+     * beta_h and the velocity m_h / beta_h. */
     void
     evaluate(
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>> &reference_points,
       MixtureValues<dim>                    &values) const;
 
-    /** Integral of beta_h (u - m_h / beta_h) over the mesh: the force the
-     * grains' drag exerts on the fluid, measured through the fluid's own
-     * fields. */
+    /** Minus the integral of beta_h u - m_h (with the drag as a field) and
+     * of alpha_h grad p over the mesh: the force the grains' drag exerts on
+     * the fluid, measured through the fluid's own fields. */
     dealii::Tensor<1, dim>
     force_on_fluid(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
@@ -84,11 +101,28 @@ namespace ImmersedGrains
       const std::array<const typename HelmholtzFilter<dim>::Vector *, n_fields>
         &fields) const;
 
-    HelmholtzFilter<dim>                                   filter;
-    const double                                           length;
-    typename HelmholtzFilter<dim>::Vector                  beta;
+    // Filters the Q1 fields of a velocity-like quantity of the fluid.
+    template <typename Quantity>
+    void
+    filter_quantity(const dealii::DoFHandler<dim> &fluid_dof_handler,
+                    const Quantity                &quantity,
+                    std::array<typename HelmholtzFilter<dim>::Vector, dim> &);
+
+    std::vector<dealii::Tensor<1, dim>>
+    vector_values(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &reference_points,
+      const std::array<typename HelmholtzFilter<dim>::Vector, dim> &) const;
+
+    HelmholtzFilter<dim>                  filter;
+    const double                          length;
+    const bool                            drag_as_field;
+    const bool                            implicit_velocity;
+    typename HelmholtzFilter<dim>::Vector beta, alpha, mobility;
+    std::array<typename HelmholtzFilter<dim>::Vector, dim> free_flux;
     std::array<typename HelmholtzFilter<dim>::Vector, dim> momentum;
     std::array<typename HelmholtzFilter<dim>::Vector, dim> velocity;
+    std::array<typename HelmholtzFilter<dim>::Vector, dim> pressure_gradient;
   };
 } // namespace ImmersedGrains
 

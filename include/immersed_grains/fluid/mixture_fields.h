@@ -29,6 +29,11 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> grain_velocity;
     std::vector<dealii::Tensor<1, dim>> solid_flux; // (1 - phi) u_p
     std::vector<double>                 mass_source;
+    // With the grains' velocity implicit (doc/theory.md 3): the momentum
+    // equation gains alpha grad p (the pressure force on grains tied to the
+    // fluid by drag), and the solid flux is s + alpha u - k grad p.
+    std::vector<double> pressure_gradient_weight; // alpha
+    std::vector<double> pressure_mobility;        // k
   };
 
 
@@ -100,6 +105,14 @@ namespace ImmersedGrains
     dealii::Point<dim>     reference_location; // in its cell
     double                 beta;               // [kg/s]
     dealii::Tensor<1, dim> velocity;           // v_i
+    // With the grain's new velocity eliminated into the fluid solve
+    // (Coupling, doc/theory.md 3): theta_i = dt gamma_i / (m_i + dt gamma_i)
+    // of its volume follows the fluid, alpha_i = V_i theta_i [m^3]; its
+    // pressure mobility k_i = dt V_i^2 / (m_i + dt gamma_i) [m^4 s/kg]; and
+    // the rest of its volume flux, V_i (1 - theta_i) v~_i [m^4/s].
+    double                 pressure_weight   = 0;
+    double                 pressure_mobility = 0;
+    dealii::Tensor<1, dim> free_flux;
   };
 
 
