@@ -7,3 +7,6 @@ export OMPI_MCA_rmaps_base_oversubscribe=1
 export DEAL_II_NUM_THREADS=${DEAL_II_NUM_THREADS:-1}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 export CCACHE_DIR=${CCACHE_DIR:-$HOME/.ccache}
+# Paths relative to the checkout in ccache's hashes: a second clone (CI's
+# fresh one) reuses the objects of the first.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}
