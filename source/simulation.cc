@@ -53,6 +53,7 @@ namespace ImmersedGrains
                                "max_reynolds",
                                "drag_force_on_grains",
                                "momentum_exchange_error",
+                               "pressure_drop",
                                "contact_residual",
                                "contact_converged",
                                "max_contact_force",
@@ -121,6 +122,12 @@ namespace ImmersedGrains
                         "run, printed as yes/no in test mode, separated by "
                         "';': 'column < v', 'column > v', 'column in [a, "
                         "b]'.");
+      prm.declare_entry("Pressure drop points",
+                        "",
+                        Anything(),
+                        "Two points 'x1,y1[,z1]; x2,y2[,z2]' of the mesh: the "
+                        "statistics column pressure_drop is p(first) - "
+                        "p(second) [Pa] (a fixed bed's pressure drop, say).");
     }
     prm.leave_subsection();
 
@@ -172,8 +179,18 @@ namespace ImmersedGrains
                       "Test columns",
                       prm.get("Test columns"),
                       "no statistics column named '" + c + "'");
-      test_every  = prm.get_integer("Test every steps");
-      test_checks = parse_test_checks(prm.get("Test checks"),
+      test_every = prm.get_integer("Test every steps");
+      pressure_drop_points =
+        parse_point_list<dim>(prm.get("Pressure drop points"),
+                              where,
+                              "Pressure drop points");
+      where.require(pressure_drop_points.empty() ||
+                      pressure_drop_points.size() == 2,
+                    "Pressure drop points",
+                    prm.get("Pressure drop points"),
+                    "needs two points separated by ';'");
+      pressure_drop_text = prm.get("Pressure drop points");
+      test_checks        = parse_test_checks(prm.get("Test checks"),
                                       statistics,
                                       where,
                                       "Test checks");
@@ -181,6 +198,15 @@ namespace ImmersedGrains
     prm.leave_subsection();
 
     geometry.parse_parameters(prm, file);
+    for (const auto &point : pressure_drop_points)
+      for (unsigned int d = 0; d < dim; ++d)
+        InputLocation{file, "Output"}.require(point[d] >=
+                                                  geometry.lower_corner[d] &&
+                                                point[d] <=
+                                                  geometry.upper_corner[d],
+                                              "Pressure drop points",
+                                              pressure_drop_text,
+                                              "a point lies outside the mesh");
     fluid_parameters.parse_parameters(prm, file, geometry);
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
@@ -450,6 +476,10 @@ namespace ImmersedGrains
       const double fluid_volume = fluid->integrate_fluid_fraction();
       statistics.set("dofs", fluid->n_dofs());
       statistics.set("fluid_volume", fluid_volume);
+      if (!pressure_drop_points.empty())
+        statistics.set("pressure_drop",
+                       fluid->pressure_at(pressure_drop_points[0]) -
+                         fluid->pressure_at(pressure_drop_points[1]));
       statistics.set("solid_volume",
                      coupling ? coupling->solid_volume() :
                                 volume - fluid_volume);

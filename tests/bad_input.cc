@@ -157,6 +157,21 @@ end
              "nonsense\nend\n",
          "Test columns",
          "nonsense"},
+        {"pressure_drop_one_point",
+         "set Dimension = 2\nsubsection Output\n  set Pressure drop points = "
+             "0.5, 0.5\nend\n",
+         "Pressure drop points",
+         "0.5, 0.5"},
+        {"pressure_drop_outside",
+         "set Dimension = 2\nsubsection Output\n  set Pressure drop points = "
+             "0.5, 0.5; 2, 0.5\nend\n",
+         "Pressure drop points",
+         "0.5, 0.5; 2, 0.5"},
+        {"implicit_coupling_not_bool",
+         "set Dimension = 2\nsubsection Coupling\n  set Implicit coupling = "
+             "maybe\nend\n",
+         "Implicit coupling",
+         "maybe"},
   };
 
   unsigned int failures = 0;

@@ -80,12 +80,14 @@ namespace ImmersedGrains
     double      time_step          = 1;
     bool        adaptive_time_step = false;
 
-    unsigned int             write_fields_every = 0;
-    bool                     test_output        = false;
-    bool                     quiet              = false;
-    std::vector<std::string> test_columns;
-    unsigned int             test_every = 1;
-    std::vector<TestCheck>   test_checks;
+    unsigned int                    write_fields_every = 0;
+    bool                            test_output        = false;
+    bool                            quiet              = false;
+    std::vector<std::string>        test_columns;
+    unsigned int                    test_every = 1;
+    std::vector<TestCheck>          test_checks;
+    std::vector<dealii::Point<dim>> pressure_drop_points;
+    std::string                     pressure_drop_text;
 
     Geometry<dim>                      geometry;
     FluidParameters<dim>               fluid_parameters;

@@ -199,6 +199,34 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  double
+  FluidSolver<dim>::pressure_at(const dealii::Point<dim> &point) const
+  {
+    double sum = 0, count = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->point_inside(point))
+      {
+        const dealii::Point<dim> reference =
+          mapping.transform_real_to_unit_cell(cell, point);
+        const dealii::Quadrature<dim> one_point(reference);
+        dealii::FEValues<dim>         fe_values(mapping,
+                                        fe,
+                                        one_point,
+                                        dealii::update_values);
+        fe_values.reinit(cell);
+        std::vector<double> value(1);
+        fe_values[dealii::FEValuesExtractors::Scalar(dim)].get_function_values(
+          solution, value);
+        sum += value[0];
+        count += 1;
+      }
+    sum   = dealii::Utilities::MPI::sum(sum, mpi_communicator);
+    count = dealii::Utilities::MPI::sum(count, mpi_communicator);
+    return count > 0 ? sum / count : 0.0;
+  }
+
+
+  template <int dim>
   void
   FluidSolver<dim>::set_forcing(std::shared_ptr<dealii::Function<dim>> f)
   {

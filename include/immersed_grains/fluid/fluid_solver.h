@@ -113,6 +113,11 @@ namespace ImmersedGrains
     void
     add_data_vectors(dealii::DataOut<dim> &data_out) const;
 
+    /** The pressure at a point of the mesh (collective: every rank calls
+     * it; the mean over the cells that contain the point). */
+    double
+    pressure_at(const dealii::Point<dim> &point) const;
+
     /** Integral of the fluid fraction over the mesh. */
     double
     integrate_fluid_fraction() const;
