@@ -384,7 +384,11 @@ namespace ImmersedGrains
         leaving.push_back(p);
         continue;
       }
-      p->set_location(x);
+      // Fixed grains keep their location bit for bit: set again, a grain
+      // sitting exactly on a mesh vertex may not be found again by the
+      // sort below.
+      if (!parameters.fixed)
+        p->set_location(x);
       auto props = p->get_properties();
       for (unsigned int d = 0; d < dim; ++d)
         props[properties.velocity + d] = c.velocity[i][d];
@@ -411,7 +415,8 @@ namespace ImmersedGrains
     const unsigned long count_before =
       dealii::Utilities::MPI::sum<unsigned long>(
         particles.n_locally_owned_particles(), comm);
-    particles.sort_particles_into_subdomains_and_cells();
+    if (!parameters.fixed)
+      particles.sort_particles_into_subdomains_and_cells();
     // A grain the ParticleHandler cannot place went through a wall or, under
     // MPI, farther than the ghost layer in one step: never drop it quietly.
     const unsigned long lost_now =
