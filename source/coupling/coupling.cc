@@ -118,6 +118,7 @@ namespace ImmersedGrains
     projection->setup();
     if (filtered_drag)
       filtered_drag->setup();
+    filtered_velocity_current = false;
   }
 
 
@@ -152,6 +153,20 @@ namespace ImmersedGrains
   }
 
 
+  namespace
+  {
+    template <typename PointValues>
+    auto
+    velocities_of(const std::vector<PointValues> &values)
+    {
+      std::vector<decltype(PointValues::velocity)> result;
+      for (const auto &v : values)
+        result.push_back(v.velocity);
+      return result;
+    }
+  } // namespace
+
+
   template <int dim>
   std::vector<dealii::Tensor<1, dim>>
   Coupling<dim>::felt_velocity(
@@ -161,11 +176,7 @@ namespace ImmersedGrains
   {
     if (drag_as_field())
       return filtered_drag->filtered_velocity(cell, references);
-    const auto values = fluid.point_values(cell, references);
-    std::vector<dealii::Tensor<1, dim>> result(values.size());
-    for (unsigned int q = 0; q < values.size(); ++q)
-      result[q] = values[q].velocity;
-    return result;
+    return velocities_of(fluid.point_values(cell, references));
   }
 
 
@@ -228,7 +239,9 @@ namespace ImmersedGrains
               grain_parameters.fixed ? 0.0 : props[layout.velocity + d];
           samples.push_back(s);
         }
-      });
+      },
+      // The implicit coupling replaces the projected flux.
+      !(parameters.two_way && parameters.implicit_coupling));
   }
 
 
@@ -239,19 +252,25 @@ namespace ImmersedGrains
                                     const double            dt)
   {
     dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
-    auto              &arrays = const_cast<Grains<dim> &>(grains).step_arrays();
-    const auto        &c      = arrays.contact;
-    const unsigned int n      = c.velocity.size();
+    auto                      &arrays = grains.step_arrays();
+    const auto                &c      = arrays.contact;
+    const unsigned int         n      = c.velocity.size();
     lagged_force.assign(n, dealii::Tensor<1, dim>());
     gamma.assign(n, 0.0);
     cell_drags.assign(triangulation.n_active_cells(), {});
     reynolds_max = 0;
 
-    if (drag_as_field())
+    // The fluid solution has not changed since set_grain_forces() filtered
+    // it, except before the first step or after a mesh change.
+    if (drag_as_field() && !filtered_velocity_current)
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
                                      fluid.get_solution());
+    filtered_velocity_current = true;
     const bool implicit_velocity =
       parameters.two_way && parameters.implicit_coupling;
+    // Values at the grains' centres: the felt velocity unless filtered,
+    // the lagged pressure gradient unless implicit.
+    const bool at_centres             = !drag_as_field() || !implicit_velocity;
     const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
     MixtureValues<dim>              mixture;
@@ -260,8 +279,12 @@ namespace ImmersedGrains
       references,
       [&](const auto &cell, const unsigned int first, const unsigned int end)
       {
-        const auto fluid_values = fluid.point_values(cell, references);
-        const auto felt         = felt_velocity(fluid, cell, references);
+        const auto fluid_values =
+          at_centres ? fluid.point_values(cell, references) :
+                       decltype(fluid.point_values(cell, references))();
+        const auto felt = drag_as_field() ?
+                            filtered_drag->filtered_velocity(cell, references) :
+                            velocities_of(fluid_values);
         projection->evaluate(cell, references, references, 0, mixture);
         for (unsigned int i = first; i < end; ++i)
         {
@@ -338,28 +361,36 @@ namespace ImmersedGrains
     arrays.drag_coefficient.resize(n);
     arrays.drag_velocity.resize(n);
 
-    if (drag_as_field())
-      filtered_drag->filter_velocity(fluid.get_dof_handler(),
-                                     fluid.get_solution());
     const bool implicit_velocity =
       parameters.two_way && parameters.implicit_coupling;
+    if (drag_as_field())
+      filtered_drag->filter_velocity(fluid.get_dof_handler(),
+                                     fluid.get_solution(),
+                                     implicit_velocity);
+    filtered_velocity_current = true;
     std::vector<dealii::Point<dim>> references;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
       [&](const auto &cell, const unsigned int first, const unsigned int end)
       {
-        const auto felt = felt_velocity(fluid, cell, references);
-        // The new pressure gradient, as the fluid solve assumed: filtered
-        // with the drag as a field (the adjoint of spreading alpha), else
-        // at the centre.
-        std::vector<dealii::Tensor<1, dim>> pressure_gradient;
-        if (implicit_velocity && drag_as_field())
-          pressure_gradient =
-            filtered_drag->filtered_pressure_gradient(cell, references);
-        else if (implicit_velocity)
+        // The felt velocity and the new pressure gradient, as the fluid
+        // solve assumed: filtered with the drag as a field (the adjoint of
+        // spreading), else at the centre.
+        std::vector<dealii::Tensor<1, dim>> felt, pressure_gradient;
+        if (drag_as_field())
+        {
+          felt = filtered_drag->filtered_velocity(cell, references);
+          if (implicit_velocity)
+            pressure_gradient =
+              filtered_drag->filtered_pressure_gradient(cell, references);
+        }
+        else
           for (const auto &v : fluid.point_values(cell, references))
+          {
+            felt.push_back(v.velocity);
             pressure_gradient.push_back(v.pressure_gradient);
+          }
         for (unsigned int i = first; i < end; ++i)
         {
           const auto &u           = felt[i - first];
@@ -425,7 +456,7 @@ namespace ImmersedGrains
       on_fluid += dealii::Utilities::MPI::sum(point_force, comm);
     }
     // The drag in the grains' implicit update, with their final velocity.
-    const auto &arrays = const_cast<Grains<dim> &>(grains).step_arrays();
+    const auto &arrays = grains.step_arrays();
     for (unsigned int i = 0; i < arrays.drag_coefficient.size(); ++i)
       on_grains += arrays.drag_coefficient[i] *
                    (arrays.drag_velocity[i] - arrays.contact.velocity[i]);

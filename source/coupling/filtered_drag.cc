@@ -136,6 +136,36 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  template <typename F>
+  void
+  FilteredDrag<dim>::for_each_cell(
+    const dealii::DoFHandler<dim> &fluid_dof_handler,
+    const F                       &f) const
+  {
+    const auto               &fluid_fe = fluid_dof_handler.get_fe();
+    const dealii::QGauss<dim> quadrature(fluid_fe.degree + 1);
+    dealii::FEValues<dim>     fluid_values(filter.get_mapping(),
+                                       fluid_fe,
+                                       quadrature,
+                                       dealii::update_values |
+                                         dealii::update_gradients |
+                                         dealii::update_JxW_values);
+    dealii::FEValues<dim>     filter_values(filter.get_mapping(),
+                                        filter.get_fe(),
+                                        quadrature,
+                                        dealii::update_values);
+    for (const auto &cell : fluid_dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        fluid_values.reinit(cell);
+        const auto filter_cell = filter.dof_cell(cell);
+        filter_values.reinit(filter_cell);
+        f(fluid_values, filter_values, filter_cell);
+      }
+  }
+
+
+  template <int dim>
   template <typename Quantity>
   void
   FilteredDrag<dim>::filter_quantity(
@@ -147,46 +177,36 @@ namespace ImmersedGrains
     for (auto &r : rhs)
       r = filter.make_owned_vector();
 
-    // Q1 x Q2 is integrated exactly by the fluid's own Gauss rule.
-    const auto                         &fluid_fe = fluid_dof_handler.get_fe();
-    const dealii::QGauss<dim>           quadrature(fluid_fe.degree + 1);
-    dealii::FEValues<dim>               fluid_values(filter.get_mapping(),
-                                       fluid_fe,
-                                       quadrature,
-                                       dealii::update_values |
-                                         dealii::update_gradients |
-                                         dealii::update_JxW_values);
-    dealii::FEValues<dim>               filter_values(filter.get_mapping(),
-                                        filter.get_fe(),
-                                        quadrature,
-                                        dealii::update_values);
-    std::vector<dealii::Tensor<1, dim>> values(quadrature.size());
     const unsigned int                  n = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::Tensor<1, dim>> values;
     std::array<dealii::Vector<double>, dim>      local;
     std::vector<dealii::types::global_dof_index> indices(n);
     for (auto &l : local)
       l.reinit(n);
 
-    for (const auto &cell : fluid_dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-      {
-        fluid_values.reinit(cell);
-        const auto filter_cell = filter.dof_cell(cell);
-        filter_values.reinit(filter_cell);
-        quantity(fluid_values, values);
-        for (auto &l : local)
-          l = 0;
-        for (unsigned int q = 0; q < quadrature.size(); ++q)
-          for (unsigned int j = 0; j < n; ++j)
-          {
-            const double weight =
-              filter_values.shape_value(j, q) * fluid_values.JxW(q);
-            for (unsigned int d = 0; d < dim; ++d)
-              local[d](j) += values[q][d] * weight;
-          }
-        for (unsigned int d = 0; d < dim; ++d)
-          filter.add_cell_contribution(filter_cell, local[d], indices, rhs[d]);
-      }
+    for_each_cell(fluid_dof_handler,
+                  [&](const dealii::FEValues<dim> &fluid_values,
+                      const dealii::FEValues<dim> &filter_values,
+                      const auto                  &filter_cell)
+                  {
+                    values.resize(fluid_values.n_quadrature_points);
+                    quantity(fluid_values, values);
+                    for (auto &l : local)
+                      l = 0;
+                    for (unsigned int q = 0; q < values.size(); ++q)
+                      for (unsigned int j = 0; j < n; ++j)
+                      {
+                        const double weight =
+                          filter_values.shape_value(j, q) * fluid_values.JxW(q);
+                        for (unsigned int d = 0; d < dim; ++d)
+                          local[d](j) += values[q][d] * weight;
+                      }
+                    for (unsigned int d = 0; d < dim; ++d)
+                      filter.add_cell_contribution(filter_cell,
+                                                   local[d],
+                                                   indices,
+                                                   rhs[d]);
+                  });
     for (unsigned int d = 0; d < dim; ++d)
     {
       rhs[d].compress(dealii::VectorOperation::add);
@@ -199,7 +219,8 @@ namespace ImmersedGrains
   void
   FilteredDrag<dim>::filter_velocity(
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
-    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution)
+    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+    const bool                                        with_pressure_gradient)
   {
     const dealii::FEValuesExtractors::Vector velocities(0);
     const dealii::FEValuesExtractors::Scalar pressure(dim);
@@ -209,7 +230,7 @@ namespace ImmersedGrains
           std::vector<dealii::Tensor<1, dim>> &values)
       { fe_values[velocities].get_function_values(fluid_solution, values); },
       velocity);
-    if (drag_as_field)
+    if (with_pressure_gradient)
       filter_quantity(
         fluid_dof_handler,
         [&](const dealii::FEValues<dim>         &fe_values,
@@ -339,46 +360,40 @@ namespace ImmersedGrains
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
     const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution) const
   {
-    const auto               &fluid_fe = fluid_dof_handler.get_fe();
-    const dealii::QGauss<dim> quadrature(fluid_fe.degree + 1);
-    dealii::FEValues<dim>     fluid_values(filter.get_mapping(),
-                                       fluid_fe,
-                                       quadrature,
-                                       dealii::update_values |
-                                         dealii::update_gradients |
-                                         dealii::update_JxW_values);
-    dealii::FEValues<dim>     filter_values(filter.get_mapping(),
-                                        filter.get_fe(),
-                                        quadrature,
-                                        dealii::update_values);
     const dealii::FEValuesExtractors::Vector velocities(0);
     const dealii::FEValuesExtractors::Scalar pressure(dim);
-    std::vector<dealii::Tensor<1, dim>>      u(quadrature.size());
-    std::vector<dealii::Tensor<1, dim>>      grad_p(quadrature.size());
-    std::vector<double> b(quadrature.size()), a(quadrature.size());
-    std::array<std::vector<double>, dim> m;
-    for (auto &v : m)
-      v.resize(quadrature.size());
-    dealii::Tensor<1, dim> force;
-    for (const auto &cell : fluid_dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
+    std::vector<dealii::Tensor<1, dim>>      u, grad_p;
+    std::vector<double>                      b, a;
+    std::array<std::vector<double>, dim>     m;
+    dealii::Tensor<1, dim>                   force;
+    for_each_cell(
+      fluid_dof_handler,
+      [&](const dealii::FEValues<dim> &fluid_values,
+          const dealii::FEValues<dim> &filter_values,
+          const auto &)
       {
-        fluid_values.reinit(cell);
-        filter_values.reinit(filter.dof_cell(cell));
+        const unsigned int n_q = fluid_values.n_quadrature_points;
+        grad_p.resize(n_q);
+        a.resize(n_q);
         fluid_values[pressure].get_function_gradients(fluid_solution, grad_p);
         filter_values.get_function_values(alpha, a);
-        for (unsigned int q = 0; q < quadrature.size(); ++q)
+        for (unsigned int q = 0; q < n_q; ++q)
           force -= a[q] * grad_p[q] * fluid_values.JxW(q);
         if (!drag_as_field)
-          continue;
+          return;
+        u.resize(n_q);
+        b.resize(n_q);
         fluid_values[velocities].get_function_values(fluid_solution, u);
         filter_values.get_function_values(beta, b);
         for (unsigned int d = 0; d < dim; ++d)
+        {
+          m[d].resize(n_q);
           filter_values.get_function_values(momentum[d], m[d]);
-        for (unsigned int q = 0; q < quadrature.size(); ++q)
+        }
+        for (unsigned int q = 0; q < n_q; ++q)
           for (unsigned int d = 0; d < dim; ++d)
             force[d] -= (b[q] * u[q][d] - m[d][q]) * fluid_values.JxW(q);
-      }
+      });
     return dealii::Utilities::MPI::sum(
       force, fluid_dof_handler.get_triangulation().get_communicator());
   }

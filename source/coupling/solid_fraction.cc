@@ -69,7 +69,8 @@ namespace ImmersedGrains
   SolidFraction<dim>::project(
     const std::function<
       void(const typename dealii::Triangulation<dim>::active_cell_iterator &,
-           std::vector<GrainSample<dim>> &)> &samples)
+           std::vector<GrainSample<dim>> &)> &samples,
+    const bool                                with_flux)
   {
     auto volume_rhs = filter.make_owned_vector();
     std::array<typename HelmholtzFilter<dim>::Vector, dim> flux_rhs;
@@ -116,7 +117,10 @@ namespace ImmersedGrains
 
     filter.solve(volume_rhs, fraction);
     for (unsigned int d = 0; d < dim; ++d)
-      filter.solve(flux_rhs[d], flux[d]);
+      if (with_flux)
+        filter.solve(flux_rhs[d], flux[d]);
+      else
+        flux[d] = 0;
 
     unsigned int local_clamped = 0;
     for (const auto i : filter.locally_owned_dofs())

@@ -445,6 +445,14 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  const GrainStepArrays<dim> &
+  Grains<dim>::step_arrays() const
+  {
+    return arrays;
+  }
+
+
+  template <int dim>
   GrainStatistics<dim>
   Grains<dim>::compute_statistics() const
   {

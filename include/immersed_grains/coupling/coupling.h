@@ -167,6 +167,8 @@ namespace ImmersedGrains
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 
     double reynolds_max = 0;
+    // Whether the filtered velocity is that of the fluid's current solution.
+    bool filtered_velocity_current = false;
   };
 } // namespace ImmersedGrains
 

@@ -55,12 +55,13 @@ namespace ImmersedGrains
              const typename dealii::Triangulation<dim>::active_cell_iterator &,
              std::vector<PointDrag<dim>> &)> &drags);
 
-    /** Filters the velocity (and, with the drag as a field, the pressure
-     * gradient) of a Q2^dim-Q1 fluid solution. */
+    /** Filters the velocity (and, if @p with_pressure_gradient, the
+     * pressure gradient) of a Q2^dim-Q1 fluid solution. */
     void
     filter_velocity(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
-      const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution);
+      const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+      bool with_pressure_gradient = false);
 
     /** The filtered velocity at points of a cell. */
     std::vector<dealii::Tensor<1, dim>>
@@ -100,6 +101,14 @@ namespace ImmersedGrains
       const std::vector<dealii::Point<dim>> &reference_points,
       const std::array<const typename HelmholtzFilter<dim>::Vector *, n_fields>
         &fields) const;
+
+    // Calls @p f(fluid_values, filter_values, filter_cell) on each locally
+    // owned cell, both FEValues at the fluid's Gauss points (which
+    // integrate Q1 x Q2 x Q2 exactly).
+    template <typename F>
+    void
+    for_each_cell(const dealii::DoFHandler<dim> &fluid_dof_handler,
+                  const F                       &f) const;
 
     // Filters the Q1 fields of a velocity-like quantity of the fluid.
     template <typename Quantity>

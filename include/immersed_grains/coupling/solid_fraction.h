@@ -66,12 +66,14 @@ namespace ImmersedGrains
 
     /**
      * Fills the fields from @p samples, which lists the grains of each
-     * locally owned cell.
+     * locally owned cell; the flux only if @p with_flux (else zero: the
+     * implicit coupling supplies its own).
      */
     void
     project(const std::function<void(
               const typename dealii::Triangulation<dim>::active_cell_iterator &,
-              std::vector<GrainSample<dim>> &)> &samples);
+              std::vector<GrainSample<dim>> &)> &samples,
+            bool                                 with_flux = true);
 
     /** Integral of phi_s over the mesh. */
     double

@@ -157,6 +157,9 @@ namespace ImmersedGrains
     GrainStepArrays<dim> &
     step_arrays();
 
+    const GrainStepArrays<dim> &
+    step_arrays() const;
+
     GrainStatistics<dim>
     compute_statistics() const;
 
