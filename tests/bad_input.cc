@@ -114,9 +114,15 @@ end
         {"grains_impossible_fraction",
          "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
              "Radius = 0.02\n  subsection Placement\n    set Shape = box\n    "
-             "set Size = 0.5\n    set Solid fraction = 0.7\n  end\nend\n",
+             "set Size = 0.5\n    set Solid fraction = 0.95\n  end\nend\n",
          "Solid fraction",
-         "0.7"},
+         "0.95"},
+        {"grains_unreachable_fraction",
+         "set Dimension = 3\nsubsection Grains\n  set Enabled = true\n  set "
+             "Radius = 0.05\n  subsection Placement\n    set Shape = box\n    "
+             "set Size = 0.5\n    set Solid fraction = 0.6\n  end\nend\n",
+         "Solid fraction",
+         "0.6"},
         {"grains_fill_outside_domain",
          "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
              "Radius = 0.02\n  subsection Placement\n    set Shape = box\n    "

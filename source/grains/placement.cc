@@ -105,6 +105,78 @@ namespace ImmersedGrains
       return radii;
     }
 
+    // Pushes overlapping pairs apart, each grain by half the overlap along
+    // the line of centres (Gauss-Seidel: moved at once), and grains back
+    // inside the region, until no pair overlaps. Returns the rounds it
+    // took, or invalid_unsigned_int if 20000 rounds did not suffice.
+    template <int dim>
+    unsigned int
+    remove_overlaps(std::vector<GrainSeed<dim>> &grains,
+                    const Point<dim>            &lower,
+                    const Point<dim>            &upper,
+                    const bool                   ball,
+                    const Point<dim>            &center,
+                    const double                 ball_radius)
+    {
+      const unsigned int n           = grains.size();
+      const auto         keep_inside = [&](GrainSeed<dim> &g)
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          g.position[d] =
+            std::clamp(g.position[d], lower[d] + g.radius, upper[d] - g.radius);
+        if (ball)
+        {
+          const Tensor<1, dim> a     = g.position - center;
+          const double         reach = ball_radius - g.radius;
+          if (a.norm() > reach)
+            g.position = center + a * (reach / a.norm());
+        }
+      };
+      std::vector<Point<dim>>              x(n);
+      std::vector<double>                  r(n);
+      std::vector<Contact::GrainPair<dim>> pairs;
+      Contact::BucketGrid<dim>             grid(lower, upper);
+      for (unsigned int round = 0; round < 20000; ++round)
+      {
+        for (unsigned int i = 0; i < n; ++i)
+        {
+          x[i] = grains[i].position;
+          r[i] = grains[i].radius;
+        }
+        grid.find_pairs(x, r, 0, pairs);
+        bool moved = false;
+        for (const auto &pair : pairs)
+        {
+          auto          &a       = grains[pair.first];
+          auto          &b       = grains[pair.second];
+          Tensor<1, dim> ab      = b.position - a.position;
+          double         d       = ab.norm();
+          const double   overlap = a.radius + b.radius - d;
+          if (overlap <= 0)
+            continue;
+          if (d == 0)
+          {
+            // Coincident centres: any direction will do.
+            ab    = Tensor<1, dim>();
+            ab[0] = 1;
+            d     = 1;
+          }
+          // A little more than the overlap (far above round-off in the
+          // positions), so that a pair pushed apart stays apart.
+          const Tensor<1, dim> push =
+            ((overlap + 1e-9 * (a.radius + b.radius)) / (2 * d)) * ab;
+          a.position -= push;
+          b.position += push;
+          keep_inside(a);
+          keep_inside(b);
+          moved = true;
+        }
+        if (!moved)
+          return round;
+      }
+      return dealii::numbers::invalid_unsigned_int;
+    }
+
     // Random sequential addition into a ball or box, largest grains first.
     template <int dim>
     std::vector<GrainSeed<dim>>
@@ -146,6 +218,17 @@ namespace ImmersedGrains
                     what,
                     value,
                     "the grains' volume exceeds the region's");
+      // No arrangement of equal grains is denser than the hexagonal
+      // (discs) or face-centred cubic (spheres) packing.
+      const double densest =
+        dim == 2 ? M_PI / (2 * std::sqrt(3.)) : M_PI / (3 * std::sqrt(2.));
+      where.require(total < densest * region_volume,
+                    what,
+                    value,
+                    "a solid fraction of " +
+                      std::to_string(total / region_volume) +
+                      " exceeds the densest packing of equal grains (" +
+                      std::to_string(densest) + ")");
 
       // Hash grid of placed grains, cell edge 2 r_max: overlaps can only be
       // with grains in the 3^dim cells around.
@@ -176,7 +259,8 @@ namespace ImmersedGrains
 
       std::vector<GrainSeed<dim>> grains;
       grains.reserve(radii.size());
-      const unsigned int max_tries = 5000;
+      std::vector<double> unplaced;
+      const unsigned int  max_tries = 5000;
       for (const double r : radii)
       {
         bool placed = false;
@@ -217,22 +301,38 @@ namespace ImmersedGrains
           placed = true;
         }
         if (!placed)
-        {
-          double placed_volume = 0;
-          for (const auto &g : grains)
-            placed_volume += grain_volume<dim>(g.radius);
-          where.fail(what,
-                     value,
-                     "random sequential addition found room for only " +
-                       std::to_string(grains.size()) + " of " +
-                       std::to_string(radii.size()) +
-                       " grains (solid fraction " +
-                       std::to_string(placed_volume / region_volume) +
-                       "; it jams near " + (dim == 2 ? "0.547" : "0.38") +
-                       " for equal grains): lower it, enlarge the region "
-                       "or use Shape = lattice");
-        }
+          unplaced.push_back(r);
       }
+      if (unplaced.empty())
+        return grains;
+
+      // Random sequential addition jams well below random close packing:
+      // put the rest at random (overlapping) positions and push
+      // overlapping pairs apart until none overlaps. The result is still
+      // a homogeneous random arrangement (no lattice, no ordering by
+      // insertion) up to about 0.5 (spheres) and 0.75 (discs).
+      for (const double r : unplaced)
+      {
+        Point<dim> x;
+        do
+          for (unsigned int d = 0; d < dim; ++d)
+            x[d] = random.uniform(lower[d] + r, upper[d] - r);
+        while (ball && (x - prm.center).norm() > prm.size[0] - r);
+        grains.push_back({x, Tensor<1, dim>(), r});
+      }
+      const unsigned int rounds =
+        remove_overlaps(grains, lower, upper, ball, prm.center, prm.size[0]);
+      if (rounds == dealii::numbers::invalid_unsigned_int)
+        where.fail(what,
+                   value,
+                   "no arrangement without overlaps found for " +
+                     std::to_string(grains.size()) +
+                     " grains (solid fraction " +
+                     std::to_string(total / region_volume) +
+                     "; random close packing is near " +
+                     (dim == 2 ? "0.82" : "0.64") +
+                     " for equal grains): lower it, enlarge the region or "
+                     "use Shape = lattice");
       return grains;
     }
 

@@ -30,9 +30,12 @@ namespace ImmersedGrains
    * Random fills use random sequential addition: grains (largest first) are
    * put at uniformly drawn positions that do not overlap those already
    * placed. It jams near a solid fraction of 0.547 for equal discs and 0.38
-   * for equal spheres (Feder 1980; Torquato, Uche & Stillinger 2006); a
-   * grain that finds no place in a bounded number of tries ends the fill
-   * with an InputError instead of a hang.
+   * for equal spheres (Feder 1980; Torquato, Uche & Stillinger 2006), in
+   * practice (5000 tries per grain) lower. Grains that find no place are
+   * put at random positions and overlapping pairs pushed apart until none
+   * overlaps; a fill denser than the densest packing, or one that 20000
+   * rounds of this leave overlapping (towards random close packing), is an
+   * InputError instead of a hang.
    */
   template <int dim>
   std::vector<GrainSeed<dim>>
