@@ -57,7 +57,8 @@ namespace ImmersedGrains
                                "contact_residual",
                                "contact_converged",
                                "max_contact_force",
-                               "alert_distance"})
+                               "alert_distance",
+                               "grain_substeps"})
         c.emplace_back(name);
       return c;
     }
@@ -418,11 +419,21 @@ namespace ImmersedGrains
     statistics.set("fluid_residual", stats.final_residual);
     coupling->set_grain_forces(*grains, *fluid, dt);
     grains->compute_free_velocities(dt);
-    GrainStepReport report = grains->resolve_contacts(dt);
+    // Grains that this step would move too far take equal sub-steps
+    // through its fluid; the first with the force the fluid's implicit
+    // update assumed.
+    const unsigned int substeps =
+      coupling->grain_substeps() ? grains->substeps(dt) : 1;
+    const double substep = dt / substeps;
+    statistics.set("grain_substeps", substeps);
+    if (substeps > 1)
+      grains->compute_free_velocities(substep);
+    GrainStepReport report = grains->resolve_contacts(substep);
     {
       // Newton's third law between the phases: the drag the fluid receives,
       // integrated through its own fields, against the drag in the grains'
-      // implicit update.
+      // implicit update (of the first sub-step: with sub-steps the grains'
+      // later drag differs from what the fluid's prediction assumed).
       const auto [on_fluid, on_grains] =
         coupling->exchanged_forces(*grains, *fluid);
       statistics.set("drag_force_on_grains", on_grains.norm());
@@ -431,7 +442,16 @@ namespace ImmersedGrains
                        (on_fluid + on_grains).norm() / on_grains.norm() :
                        0.0);
     }
-    report.removed = grains->move_and_scatter(dt);
+    report.removed = grains->move_and_scatter(substep);
+    for (unsigned int k = 1; k < substeps; ++k)
+    {
+      grains->gather();
+      coupling->set_substep_grain_forces(*grains, *fluid, substep);
+      grains->compute_free_velocities(substep);
+      GrainStepReport later = grains->resolve_contacts(substep, true);
+      later.removed         = grains->move_and_scatter(substep);
+      report.add_substep(later);
+    }
     return report;
   }
 

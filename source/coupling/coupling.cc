@@ -56,6 +56,16 @@ namespace ImmersedGrains
         "Keeps dense beds and suspensions stable with time steps far above "
         "their relaxation time. false: both from the previous step (stable "
         "only for dilute suspensions or short steps).");
+      prm.declare_entry(
+        "Grain sub-steps",
+        "true",
+        Bool(),
+        "Where one fluid step would move a grain more than Grains/Max "
+        "displacement fraction of the smallest radius (or half a cell), the "
+        "grains take as many equal sub-steps through the fluid of that step "
+        "as keep them within it, their interaction force and drag "
+        "coefficient re-evaluated where they are at each (contacts solved "
+        "at each). false: one grain step per fluid step.");
       SolidFraction<dim>::Parameters::declare_parameters(prm);
     }
     prm.leave_subsection();
@@ -74,6 +84,7 @@ namespace ImmersedGrains
       two_way           = prm.get_bool("Two-way") && !tracers;
       drag_distribution = prm.get("Drag distribution");
       implicit_coupling = prm.get_bool("Implicit coupling");
+      grain_substeps    = prm.get_bool("Grain sub-steps");
       projection.parse_parameters(prm, file);
     }
     prm.leave_subsection();
@@ -354,21 +365,53 @@ namespace ImmersedGrains
                                   const FluidSolver<dim> &fluid,
                                   const double            dt)
   {
+    set_hooks(grains, fluid, dt, true);
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::set_substep_grain_forces(Grains<dim>            &grains,
+                                          const FluidSolver<dim> &fluid,
+                                          const double            dt)
+  {
+    set_hooks(grains, fluid, dt, false);
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::set_hooks(Grains<dim>            &grains,
+                           const FluidSolver<dim> &fluid,
+                           const double            dt,
+                           const bool              as_predicted)
+  {
     dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
     auto                      &arrays = grains.step_arrays();
-    const unsigned int         n      = arrays.contact.velocity.size();
+    const auto                &c      = arrays.contact;
+    const unsigned int         n      = c.velocity.size();
     arrays.external_force.resize(n);
     arrays.drag_coefficient.resize(n);
     arrays.drag_velocity.resize(n);
 
     const bool implicit_velocity =
       parameters.two_way && parameters.implicit_coupling;
-    if (drag_as_field())
+    // A later sub-step sees the same fluid: its filtered fields stand.
+    if (drag_as_field() && as_predicted)
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
                                      fluid.get_solution(),
                                      implicit_velocity);
     filtered_velocity_current = true;
+    if (!as_predicted)
+    {
+      // The grains moved and were re-sorted since prepare_fluid_drag():
+      // gamma and the force without drag, again, grain by grain.
+      gamma.assign(n, 0.0);
+      lagged_force.assign(n, dealii::Tensor<1, dim>());
+    }
+    const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
+    MixtureValues<dim>              mixture;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
@@ -385,30 +428,47 @@ namespace ImmersedGrains
             pressure_gradient =
               filtered_drag->filtered_pressure_gradient(cell, references);
         }
-        else
+        if (!drag_as_field() || (!implicit_velocity && !as_predicted))
           for (const auto &v : fluid.point_values(cell, references))
           {
-            felt.push_back(v.velocity);
+            if (!drag_as_field())
+              felt.push_back(v.velocity);
             pressure_gradient.push_back(v.pressure_gradient);
           }
+        if (!as_predicted)
+          projection->evaluate(cell, references, references, 0, mixture);
         for (unsigned int i = first; i < end; ++i)
         {
-          const auto &u           = felt[i - first];
+          const unsigned int k    = i - first;
+          const auto        &u    = felt[k];
           arrays.drag_velocity[i] = u;
           if (parameters.tracers)
           {
             // The limit gamma -> infinity of the implicit update: v' = u to
             // twelve digits, gravity cancelled.
-            arrays.external_force[i] =
-              -arrays.mass[i] * grain_parameters.gravity;
+            arrays.external_force[i]   = -arrays.mass[i] * g;
             arrays.drag_coefficient[i] = 1e12 * arrays.mass[i] / dt;
             continue;
           }
+          const double V = grain_volume<dim>(c.radius[i]);
+          if (!as_predicted)
+          {
+            const double    r = c.radius[i];
+            const DragInput in{r,
+                               projected_area<dim>(r),
+                               V,
+                               mixture.fluid_fraction[k],
+                               (c.velocity[i] - u).norm(),
+                               density,
+                               viscosity};
+            gamma[i]        = drag_law->coefficient(in);
+            lagged_force[i] = -density * V * g;
+          }
           arrays.external_force[i] = lagged_force[i];
-          if (implicit_velocity)
-            arrays.external_force[i] -=
-              grain_volume<dim>(arrays.contact.radius[i]) *
-              pressure_gradient[i - first];
+          // The pressure gradient of this step: in the lagged force of the
+          // predicted step unless implicit; in every later sub-step.
+          if (implicit_velocity || !as_predicted)
+            arrays.external_force[i] -= V * pressure_gradient[k];
           arrays.drag_coefficient[i] = gamma[i];
         }
       });

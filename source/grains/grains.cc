@@ -275,7 +275,7 @@ namespace ImmersedGrains
         continue;
       }
       dealii::Tensor<1, dim> momentum =
-        m * (c.velocity[i] + dt * parameters.gravity);
+        m * (c.start_velocity[i] + dt * parameters.gravity);
       double m_eff = m;
       if (force)
         momentum += dt * arrays.external_force[i];
@@ -293,8 +293,51 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  unsigned int
+  Grains<dim>::substeps(const double dt) const
+  {
+    if (parameters.fixed)
+      return 1;
+    const auto &c     = arrays.contact;
+    double      v_max = 0, r_min = std::numeric_limits<double>::max();
+    for (unsigned int i = 0; i < c.velocity.size(); ++i)
+    {
+      v_max =
+        std::max({v_max, c.velocity[i].norm(), c.start_velocity[i].norm()});
+      r_min = std::min(r_min, c.radius[i]);
+    }
+    v_max = dealii::Utilities::MPI::max(v_max, comm);
+    r_min = dealii::Utilities::MPI::min(r_min, comm);
+    if (v_max <= 0)
+      return 1;
+    // The bounds of stable_time_step(), with the velocities of this step.
+    const double step =
+      std::min(parameters.max_displacement * r_min / v_max,
+               0.5 * min_cell_size /
+                 ((1 + parameters.contact.restitution) * v_max));
+    return std::max(1., std::ceil(dt / step * (1 - 1e-12)));
+  }
+
+
+  void
+  GrainStepReport::add_substep(const GrainStepReport &later)
+  {
+    contacts.iterations += later.contacts.iterations;
+    contacts.converged = contacts.converged && later.contacts.converged;
+    contacts.residual  = std::max(contacts.residual, later.contacts.residual);
+    contacts.max_overlap =
+      std::max(contacts.max_overlap, later.contacts.max_overlap);
+    contacts.n_contacts = later.contacts.n_contacts;
+    contacts.n_active   = later.contacts.n_active;
+    max_contact_force   = std::max(max_contact_force, later.max_contact_force);
+    alert_distance      = std::max(alert_distance, later.alert_distance);
+    removed += later.removed;
+  }
+
+
+  template <int dim>
   GrainStepReport
-  Grains<dim>::resolve_contacts(const double dt)
+  Grains<dim>::resolve_contacts(const double dt, const bool add_to_step_impulse)
   {
     GrainStepReport report;
     if (!contacts)
@@ -322,9 +365,11 @@ namespace ImmersedGrains
       contacts->solve(arrays.position, c, dt, report.alert_distance);
     for (unsigned int i = 0; i < free_velocity.size(); ++i)
       arrays.contact_impulse[i] =
-        c.inverse_mass[i] > 0 ?
-          (c.velocity[i] - free_velocity[i]) / c.inverse_mass[i] :
-          dealii::Tensor<1, dim>();
+        (add_to_step_impulse ? arrays.contact_impulse[i] :
+                               dealii::Tensor<1, dim>()) +
+        (c.inverse_mass[i] > 0 ?
+           (c.velocity[i] - free_velocity[i]) / c.inverse_mass[i] :
+           dealii::Tensor<1, dim>());
     report.max_contact_force = contacts->max_contact_force();
     AssertThrow(report.contacts.converged || !parameters.stop_on_failure,
                 dealii::ExcMessage(

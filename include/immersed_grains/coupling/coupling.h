@@ -42,6 +42,10 @@ namespace ImmersedGrains
    *     update v' = (m v + dt (m g + F + gamma u)) / (m + dt gamma) then
    *     exchanges the momentum the fluid received (exactly with
    *     Drag distribution = filtered; momentum_exchange_error).
+   *  5. with Grain sub-steps, where the step would move grains too far,
+   *     the grains take several steps through the frozen fluid, each after
+   *     set_substep_grain_forces() re-evaluated their interaction force
+   *     (gamma_i from the current slip) where they are now.
    *
    * With Two-way = false the fluid sees neither the solid fraction nor the
    * drag (one-way coupling); with Tracers = true the grains take the fluid
@@ -63,6 +67,7 @@ namespace ImmersedGrains
       bool                                    tracers  = false;
       std::string                             drag_distribution = "cell";
       bool                                    implicit_coupling = true;
+      bool                                    grain_substeps    = true;
       typename SolidFraction<dim>::Parameters projection;
     };
 
@@ -95,6 +100,21 @@ namespace ImmersedGrains
     set_grain_forces(Grains<dim>            &grains,
                      const FluidSolver<dim> &fluid,
                      double                  dt);
+
+    /** The hooks for a later grain sub-step of the same fluid step: the
+     *  interaction force and gamma_i at the grains' current positions and
+     *  velocities, in the fluid of this step (call after gather()); @p dt
+     *  the sub-step. */
+    void
+    set_substep_grain_forces(Grains<dim>            &grains,
+                             const FluidSolver<dim> &fluid,
+                             double                  dt);
+
+    bool
+    grain_substeps() const
+    {
+      return parameters.grain_substeps;
+    }
 
     void
     point_drags(
@@ -160,7 +180,16 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>> &references) const;
 
+    /// The grains' hooks: @p as_predicted for the first (or only) grain
+    /// step, with gamma and the force the fluid's prediction used.
+    void
+    set_hooks(Grains<dim>            &grains,
+              const FluidSolver<dim> &fluid,
+              double                  dt,
+              bool                    as_predicted);
+
     // Per grain, in the ParticleHandler's iteration order (Grains' arrays).
+
     std::vector<dealii::Tensor<1, dim>> lagged_force; // without m g
     std::vector<double>                 gamma;
     // Per active cell: the point drags of its grains.

@@ -97,6 +97,12 @@ namespace ImmersedGrains
     double                max_contact_force = 0;
     double                alert_distance    = 0;
     unsigned long         removed           = 0; // this step, open faces
+
+    /** Folds the report of a later sub-step of the same step into this
+     *  one: iterations and removals add up, the worst of the rest is
+     *  kept, the contact count is the last sub-step's. */
+    void
+    add_substep(const GrainStepReport &later);
   };
 
   /**
@@ -143,11 +149,24 @@ namespace ImmersedGrains
     void
     gather();
 
+    /** From the velocities gathered at the start of the step (so it may
+     *  be called again with a shorter dt). */
     void
     compute_free_velocities(double dt);
 
+    /** How many equal sub-steps the step @p dt needs so that no grain
+     *  moves more than the Max displacement fraction of the smallest
+     *  radius, nor more than half the shortest cell edge, in one, judged
+     *  by the larger of each grain's start and free velocity (call after
+     *  compute_free_velocities(dt); collective). */
+    unsigned int
+    substeps(double dt) const;
+
+    /** Solves the contacts; the impulse each grain received is stored
+     *  (contact_impulse), or added to what earlier sub-steps of the same
+     *  step stored if @p add_to_step_impulse. */
     GrainStepReport
-    resolve_contacts(double dt);
+    resolve_contacts(double dt, bool add_to_step_impulse = false);
 
     /** x += dt v, removes/wraps, writes back and sorts into cells. Returns
      *  the number of grains removed on all ranks. */
