@@ -1,7 +1,8 @@
 // The projection of grain volumes onto the Q1 solid fraction conserves the
 // volume: the integral of phi_s equals the grains' total volume to 1e-12
 // relative, for the consistent and the lumped mass matrix, with and without
-// the Helmholtz smoothing, on a mesh with hanging nodes, serial and in
+// the Helmholtz smoothing, on a mesh with hanging nodes and again after the
+// mesh changed (coarsened, refined elsewhere, repartitioned), serial and in
 // parallel (.mpirun=2). The smoothing must also lower the peak of a field
 // sampled from a handful of grains on a fine mesh.
 #include <deal.II/base/mpi.h>
@@ -52,35 +53,58 @@ check(const bool lumped, const double smoothing)
   for (auto &p : positions)
     for (unsigned int d = 0; d < dim; ++d)
       p[d] = u(rng);
+  const double   total = positions.size() * volume;
   MappingQ1<dim> mapping;
-  std::map<typename Triangulation<dim>::active_cell_iterator,
-           std::vector<GrainSample<dim>>>
-    by_cell;
-  for (const auto &p : positions)
+  // Projects the grains onto the current mesh; returns the relative error
+  // of the integrated solid fraction.
+  const auto project = [&]()
   {
-    const auto found =
-      GridTools::find_active_cell_around_point(mapping, tria, p);
-    if (found.first.state() == IteratorState::valid &&
-        found.first->is_locally_owned())
-      by_cell[found.first].push_back({found.second, volume, Tensor<1, dim>()});
-  }
-  projection.project(
-    [&](const auto &cell, std::vector<GrainSample<dim>> &grains)
+    std::map<typename Triangulation<dim>::active_cell_iterator,
+             std::vector<GrainSample<dim>>>
+      by_cell;
+    for (const auto &p : positions)
     {
-      const auto it = by_cell.find(cell);
-      if (it != by_cell.end())
-        grains = it->second;
-    });
-  const double total = positions.size() * volume;
-  const double error = std::abs(projection.integral() - total) / total;
+      const auto found =
+        GridTools::find_active_cell_around_point(mapping, tria, p);
+      if (found.first.state() == IteratorState::valid &&
+          found.first->is_locally_owned())
+        by_cell[found.first].push_back(
+          {found.second, volume, Tensor<1, dim>()});
+    }
+    projection.project(
+      [&](const auto &cell, std::vector<GrainSample<dim>> &grains)
+      {
+        const auto it = by_cell.find(cell);
+        if (it != by_cell.end())
+          grains = it->second;
+      });
+    return std::abs(projection.integral() - total) / total;
+  };
+  const double error = project();
   const double peak  = projection.solid_fraction().linfty_norm();
+
+  // The mesh changes (cells near the origin coarsened back, others
+  // refined, cells move between ranks): set up again, the projection on
+  // the new mesh still conserves the volume.
+  for (const auto &cell : tria.active_cell_iterators())
+    if (cell->is_locally_owned())
+    {
+      if (cell->level() > geometry.initial_refinement)
+        cell->set_coarsen_flag();
+      else if (cell->center()[0] > 0.6)
+        cell->set_refine_flag();
+    }
+  tria.execute_coarsening_and_refinement();
+  projection.setup();
+  const double error_after = project();
   if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-    std::printf("%dD %-10s l=%.2f: volume conserved %s (error < 1e-12), peak "
-                "phi_s %.3f\n",
+    std::printf("%dD %-10s l=%.2f: volume conserved %s (error < 1e-12), "
+                "after the mesh changed %s, peak phi_s %.3f\n",
                 dim,
                 lumped ? "lumped" : "consistent",
                 smoothing,
                 error < 1e-12 ? "yes" : "NO",
+                error_after < 1e-12 ? "yes" : "NO",
                 peak);
 }
 
