@@ -284,7 +284,6 @@ namespace ImmersedGrains
     const bool at_centres             = !drag_as_field() || !implicit_velocity;
     const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
-    MixtureValues<dim>              mixture;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
@@ -293,10 +292,11 @@ namespace ImmersedGrains
         const auto fluid_values =
           at_centres ? fluid.point_values(cell, references) :
                        decltype(fluid.point_values(cell, references))();
-        const auto felt = drag_as_field() ?
-                            filtered_drag->filtered_velocity(cell, references) :
-                            velocities_of(fluid_values);
-        projection->evaluate(cell, references, references, 0, mixture);
+        const auto                felt = drag_as_field() ?
+                                           filtered_drag->filtered_velocity(cell, references) :
+                                           velocities_of(fluid_values);
+        const std::vector<double> felt_fraction =
+          projection->felt_fluid_fraction(cell, references);
         for (unsigned int i = first; i < end; ++i)
         {
           const unsigned int k = i - first;
@@ -311,7 +311,7 @@ namespace ImmersedGrains
           const DragInput              in{r,
                              projected_area<dim>(r),
                              V,
-                             mixture.fluid_fraction[k],
+                             felt_fraction[k],
                              slip.norm(),
                              density,
                              viscosity};
@@ -411,7 +411,6 @@ namespace ImmersedGrains
     }
     const dealii::Tensor<1, dim>    g = grain_parameters.gravity;
     std::vector<dealii::Point<dim>> references;
-    MixtureValues<dim>              mixture;
     for_each_cell_batch<dim>(
       grains.particle_handler(),
       references,
@@ -435,8 +434,9 @@ namespace ImmersedGrains
               felt.push_back(v.velocity);
             pressure_gradient.push_back(v.pressure_gradient);
           }
-        if (!as_predicted)
-          projection->evaluate(cell, references, references, 0, mixture);
+        const std::vector<double> felt_fraction =
+          as_predicted ? std::vector<double>() :
+                         projection->felt_fluid_fraction(cell, references);
         for (unsigned int i = first; i < end; ++i)
         {
           const unsigned int k    = i - first;
@@ -457,7 +457,7 @@ namespace ImmersedGrains
             const DragInput in{r,
                                projected_area<dim>(r),
                                V,
-                               mixture.fluid_fraction[k],
+                               felt_fraction[k],
                                (c.velocity[i] - u).norm(),
                                density,
                                viscosity};

@@ -1,3 +1,7 @@
+#include <deal.II/base/quadrature_lib.h>
+
+#include <deal.II/fe/fe_values.h>
+
 #include <deal.II/matrix_free/fe_point_evaluation.h>
 
 #include <immersed_grains/coupling/solid_fraction.h>
@@ -59,6 +63,8 @@ namespace ImmersedGrains
   {
     filter.setup(parameters.lumped, parameters.smoothing_length);
     fraction = filter.make_ghosted_vector();
+    if (parameters.smoothing_length > 0)
+      felt = filter.make_ghosted_vector();
     for (auto &f : flux)
       f = filter.make_ghosted_vector();
   }
@@ -121,6 +127,34 @@ namespace ImmersedGrains
         filter.solve(flux_rhs[d], flux[d]);
       else
         flux[d] = 0;
+
+    if (parameters.smoothing_length > 0)
+    {
+      // (N_j, phi_s): the filter's mass matrix, consistent, applied cell
+      // by cell.
+      auto                      felt_rhs = filter.make_owned_vector();
+      const dealii::QGauss<dim> quadrature(2);
+      dealii::FEValues<dim>     fe_values(filter.get_mapping(),
+                                      fe,
+                                      quadrature,
+                                      dealii::update_values |
+                                        dealii::update_JxW_values);
+      std::vector<double>       values(quadrature.size());
+      for (const auto &cell : filter.get_dof_handler().active_cell_iterators())
+        if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_values.get_function_values(fraction, values);
+          cell_volume = 0;
+          for (unsigned int q = 0; q < quadrature.size(); ++q)
+            for (unsigned int j = 0; j < n; ++j)
+              cell_volume(j) +=
+                values[q] * fe_values.shape_value(j, q) * fe_values.JxW(q);
+          filter.add_cell_contribution(cell, cell_volume, indices, felt_rhs);
+        }
+      felt_rhs.compress(dealii::VectorOperation::add);
+      filter.solve(felt_rhs, felt);
+    }
 
     unsigned int local_clamped = 0;
     for (const auto i : filter.locally_owned_dofs())
@@ -214,6 +248,30 @@ namespace ImmersedGrains
           solid[q] > 1e-12 ? evaluator.get_value(q) / solid[q] : 0.0;
       }
     }
+  }
+
+
+  template <int dim>
+  std::vector<double>
+  SolidFraction<dim>::felt_fluid_fraction(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &tria_cell,
+    const std::vector<dealii::Point<dim>> &reference_points) const
+  {
+    const auto         cell = filter.dof_cell(tria_cell);
+    const unsigned int n    = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::types::global_dof_index> indices(n);
+    cell->get_dof_indices(indices);
+    const auto &field = parameters.smoothing_length > 0 ? felt : fraction;
+    std::vector<double> result;
+    for (const auto &x : reference_points)
+    {
+      double phi_s = 0;
+      for (unsigned int i = 0; i < n; ++i)
+        phi_s += field[indices[i]] * filter.get_fe().shape_value(i, x);
+      result.push_back(
+        std::clamp(1 - phi_s, parameters.min_fluid_fraction, 1.0));
+    }
+    return result;
   }
 
 

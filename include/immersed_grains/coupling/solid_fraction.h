@@ -96,6 +96,20 @@ namespace ImmersedGrains
       double                                 time,
       MixtureValues<dim>                    &values) const override;
 
+    /**
+     * The fluid fraction a grain's drag law sees at points of a cell:
+     * with smoothing, the field phi_s filtered once more, A f = (N, phi_s).
+     * The filtered field of one grain is the filter's Green's function,
+     * singular at the grain in 3D (logarithmically in 2D), so its value
+     * at the grain itself would grow without bound as the mesh is refined
+     * under a fixed l; filtered twice it is bounded and converges. Clamped
+     * to [Minimum fluid fraction, 1].
+     */
+    std::vector<double>
+    felt_fluid_fraction(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &reference_points) const;
+
     const dealii::DoFHandler<dim> &
     get_dof_handler() const;
 
@@ -107,6 +121,7 @@ namespace ImmersedGrains
     const Parameters                                      &parameters;
     HelmholtzFilter<dim>                                   filter;
     typename HelmholtzFilter<dim>::Vector                  fraction;
+    typename HelmholtzFilter<dim>::Vector                  felt; // smoothing
     std::array<typename HelmholtzFilter<dim>::Vector, dim> flux;
     unsigned int                                           clamped = 0;
   };
