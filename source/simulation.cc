@@ -58,7 +58,8 @@ namespace ImmersedGrains
                                "contact_converged",
                                "max_contact_force",
                                "alert_distance",
-                               "grain_substeps"})
+                               "grain_substeps",
+                               "clamped_fluid_fraction_nodes"})
         c.emplace_back(name);
       return c;
     }
@@ -412,6 +413,18 @@ namespace ImmersedGrains
     // contacts with the drag-augmented mass -> positions.
     grains->gather();
     coupling->project(*grains);
+    {
+      // Grains packed beyond 1 - Minimum fluid fraction: the fluid sees the
+      // minimum there. Said when it starts, counted every step.
+      const unsigned int clamped = coupling->solid_fraction().n_clamped();
+      statistics.set("clamped_fluid_fraction_nodes", clamped);
+      if (clamped > 0 && clamped_nodes_before == 0)
+        pcout << "  warning: step " << step << ": the grains pack beyond "
+              << "1 - Coupling/Minimum fluid fraction at " << clamped
+              << " solid-fraction node(s); the fluid sees the minimum "
+              << "there (column clamped_fluid_fraction_nodes)\n";
+      clamped_nodes_before = clamped;
+    }
     coupling->prepare_fluid_drag(*grains, *fluid, dt);
     const auto stats = fluid->solve_time_step(time + dt, dt);
     fluid_iterations = stats.linear_iterations;
