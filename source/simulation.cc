@@ -425,6 +425,20 @@ namespace ImmersedGrains
               << "there (column clamped_fluid_fraction_nodes)\n";
       clamped_nodes_before = clamped;
     }
+    // (Collective: decided by the layout, which every rank shares, not by
+    // this rank's grains.)
+    if (step == 1 &&
+        grains->layout().contact_impulse != GrainPropertyLayout::absent)
+    {
+      // No contact impulse is known yet: a contact solve in the initial
+      // fluid predicts the first, so that grains resting on each other at
+      // the start are held from the first step (prepare_fluid_drag()).
+      coupling->set_substep_grain_forces(*grains, *fluid, dt);
+      grains->compute_free_velocities(dt);
+      grains->resolve_contacts(dt);
+      auto &c    = grains->step_arrays().contact;
+      c.velocity = c.start_velocity;
+    }
     coupling->prepare_fluid_drag(*grains, *fluid, dt);
     const auto stats = fluid->solve_time_step(time + dt, dt);
     fluid_iterations = stats.linear_iterations;

@@ -66,6 +66,17 @@ namespace ImmersedGrains
         "as keep them within it, their interaction force and drag "
         "coefficient re-evaluated where they are at each (contacts solved "
         "at each). false: one grain step per fluid step.");
+      prm.declare_entry(
+        "Resting threshold",
+        "1e-3",
+        Double(0),
+        "A grain whose speed is at most this fraction of the velocity its "
+        "last contact impulse removed (|v| <= f |P| / (m + dt gamma), with "
+        "the drag-augmented mass) is held by its "
+        "contacts: the fluid sees it at its velocity with its full drag, as "
+        "a fixed grain, instead of eliminating its update (which needs the "
+        "new contact impulse). Keeps packed beds at rest with time steps far "
+        "above their relaxation time. 0: never.");
       SolidFraction<dim>::Parameters::declare_parameters(prm);
     }
     prm.leave_subsection();
@@ -85,6 +96,7 @@ namespace ImmersedGrains
       drag_distribution = prm.get("Drag distribution");
       implicit_coupling = prm.get_bool("Implicit coupling");
       grain_substeps    = prm.get_bool("Grain sub-steps");
+      resting_threshold = prm.get_double("Resting threshold");
       projection.parse_parameters(prm, file);
     }
     prm.leave_subsection();
@@ -322,10 +334,28 @@ namespace ImmersedGrains
           // update (a fixed grain is infinitely heavy: full gamma, v = 0).
           PointDrag<dim> drag;
           drag.reference_location = references[k];
+          // A grain held by its contacts (it kept almost none of the
+          // velocity they removed last step, P / (m + dt gamma) with the
+          // drag-augmented mass they acted on) stays where they hold it:
+          // the fluid sees it move at its velocity, as a fixed grain,
+          // instead of eliminating an update whose contact impulse it
+          // could only guess. Predicted with that guess, a packed bed and
+          // the fluid pass its weight back and forth and diverge once the
+          // step exceeds the bed's relaxation time.
+          const bool held =
+            !arrays.contact_impulse.empty() &&
+            arrays.contact_impulse[i].norm() > 0 &&
+            c.velocity[i].norm() * (m + dt * gamma[i]) <=
+              parameters.resting_threshold * arrays.contact_impulse[i].norm();
           if (grain_parameters.fixed)
           {
             drag.beta     = gamma[i];
             drag.velocity = 0;
+          }
+          else if (held)
+          {
+            drag.beta     = gamma[i];
+            drag.velocity = c.velocity[i];
           }
           else
           {

@@ -68,6 +68,7 @@ namespace ImmersedGrains
       std::string                             drag_distribution = "cell";
       bool                                    implicit_coupling = true;
       bool                                    grain_substeps    = true;
+      double                                  resting_threshold = 1e-3;
       typename SolidFraction<dim>::Parameters projection;
     };
 
