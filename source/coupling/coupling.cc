@@ -234,9 +234,9 @@ namespace ImmersedGrains
           GrainSample<dim> s;
           s.reference_location = p.get_reference_location();
           s.volume             = grain_volume<dim>(props[layout.radius]);
+          const bool fixed     = grains.is_fixed(p);
           for (unsigned int d = 0; d < dim; ++d)
-            s.velocity[d] =
-              grain_parameters.fixed ? 0.0 : props[layout.velocity + d];
+            s.velocity[d] = fixed ? 0.0 : props[layout.velocity + d];
           samples.push_back(s);
         }
       },
@@ -311,7 +311,7 @@ namespace ImmersedGrains
           // update (a fixed grain is infinitely heavy: full gamma, v = 0).
           PointDrag<dim> drag;
           drag.reference_location = references[k];
-          if (grain_parameters.fixed)
+          if (arrays.fixed[i])
           {
             drag.beta     = gamma[i];
             drag.velocity = 0;
