@@ -5,18 +5,25 @@
 // others, the hardest case for projected Gauss-Seidel.
 //
 // Reports per N, averaged over 5 steps after a first one for warm-up:
-// contacts, Gauss-Seidel sweeps per step, contact updates per
-// second in the sweeps alone and for the whole solve (setup and write-back
-// included), nanoseconds per update, and the neighbour search time per step.
-// Goal (doc/DESIGN): a few ns per contact update, 2e7 updates/s per core.
+// contacts, iterations per step (Gauss-Seidel sweeps or APGD trial steps),
+// contact updates per second in the iterations alone and for the whole
+// solve (setup and write-back included), nanoseconds per update (one
+// contact visited once in a sweep, or once in an APGD iteration's scatter
+// and gather), the time per step to converge, and the neighbour search
+// time per step. Goal (doc/DESIGN): a few ns per contact update, 2e7
+// updates/s per core.
 //
-// Usage: contact_throughput [--friction MU] [dim] [N ...]
-//        (default: frictionless, 3D, N = 1000 10000 100000)
+// Usage: contact_throughput [--friction MU] [--solver gauss-seidel|apgd]
+//                           [--shuffle] [dim] [N ...]
+//        (default: frictionless, Gauss-Seidel, 3D, N = 1000 10000 100000;
+//        --shuffle numbers the grains in random order instead of lattice
+//        order, to measure the neighbour search on unsorted input)
 
 #include <immersed_grains/contact/bucket_grid.h>
 #include <immersed_grains/contact/contact_solver.h>
 #include <immersed_grains/contact/walls.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -87,7 +94,10 @@ namespace
 
   template <int dim>
   void
-  run(const unsigned int n, const double friction)
+  run(const unsigned int  n,
+      const double        friction,
+      const ContactMethod method,
+      const bool          shuffle)
   {
     const double r = 1e-3, rho = 2400, g = 9.81, dt = 1e-4, alert = 0.1 * r;
     // One step to warm up (allocations, cold caches), then timed steps.
@@ -100,6 +110,8 @@ namespace
     for (auto &p : x)
       for (unsigned int d = 0; d < dim; ++d)
         p[d] += jitter(random);
+    if (shuffle)
+      std::shuffle(x.begin(), x.end(), random);
 
     BucketGrid<dim>           grid(lower, upper);
     Walls<dim>                walls;
@@ -120,6 +132,7 @@ namespace
     ContactParameters parameters;
     parameters.tolerance = 1e-4;
     parameters.friction  = friction;
+    parameters.method    = method;
     ContactSolver<dim> solver(parameters);
 
     std::vector<GrainPair<dim>>   pairs;
@@ -150,18 +163,27 @@ namespace
       unsigned int iterations   = 0;
       bool         converged    = false;
       double       overlap      = 0;
-      while (!converged && iterations < parameters.max_iterations)
+      if (method == ContactMethod::apgd)
       {
-        const SweepResult s = solver.sweep();
-        ++iterations;
-        if (s.max_change <= parameters.tolerance * s.max_impulse)
-        {
-          overlap   = solver.predicted_max_overlap();
-          converged = solver.converged(s, overlap);
-        }
+        const SolverResult result =
+          solver.iterate_accelerated([] {}, [](AcceleratedMeasures &) {});
+        iterations = result.iterations;
+        converged  = result.converged;
+        overlap    = result.max_overlap;
       }
+      else
+        while (!converged && iterations < parameters.max_iterations)
+        {
+          const SweepResult s = solver.sweep();
+          ++iterations;
+          if (s.max_change <= parameters.tolerance * s.max_impulse)
+          {
+            overlap   = solver.predicted_max_overlap();
+            converged = solver.converged(s, overlap);
+          }
+        }
       sweep_time += seconds_since(sweeps_start);
-      if (!converged)
+      if (!converged && method != ContactMethod::apgd)
         overlap = solver.predicted_max_overlap();
       solver.finish(grains);
       solve_time += seconds_since(start);
@@ -177,9 +199,10 @@ namespace
       max_overlap = std::max(max_overlap, overlap);
     }
 
-    std::printf("%dD mu=%.2g N=%-7u contacts=%-8.0f sweeps/step=%-6.1f "
+    std::printf("%dD %s mu=%.2g N=%-7u contacts=%-8.0f iterations/step=%-6.1f "
                 "converged=%u/%u max overlap/r=%.1e\n",
                 dim,
+                method == ContactMethod::apgd ? "apgd" : "gauss-seidel",
                 friction,
                 n,
                 n_contacts / n_steps,
@@ -187,12 +210,13 @@ namespace
                 n_converged,
                 n_steps,
                 max_overlap / r);
-    std::printf("    sweeps: %.3g updates/s (%.1f ns/update); whole solve: "
-                "%.3g updates/s; neighbour search: %.3g s/step "
-                "(%.0f ns/grain)\n",
+    std::printf("    iterations: %.3g updates/s (%.1f ns/update); whole "
+                "solve: %.3g updates/s, %.3g s/step; neighbour search: "
+                "%.3g s/step (%.0f ns/grain)\n",
                 updates / sweep_time,
                 1e9 * sweep_time / updates,
                 updates / solve_time,
+                solve_time / n_steps,
                 search_time / n_steps,
                 1e9 * search_time / n_steps / n);
   }
@@ -203,9 +227,34 @@ main(int argc, char **argv)
 {
   std::vector<std::string> args(argv + 1, argv + argc);
   double                   friction = 0;
-  if (args.size() >= 2 && args[0] == "--friction")
+  ContactMethod            method   = ContactMethod::gauss_seidel;
+  bool                     shuffle  = false;
+  while (!args.empty() && args[0].rfind("--", 0) == 0)
   {
-    friction = std::atof(args[1].c_str());
+    if (args[0] == "--shuffle")
+    {
+      shuffle = true;
+      args.erase(args.begin());
+      continue;
+    }
+    if (args.size() < 2 || (args[0] != "--friction" && args[0] != "--solver"))
+    {
+      std::fprintf(stderr,
+                   "contact_throughput: unknown option %s\n",
+                   args[0].c_str());
+      return 1;
+    }
+    if (args[0] == "--friction")
+      friction = std::atof(args[1].c_str());
+    else if (args[1] == "apgd")
+      method = ContactMethod::apgd;
+    else if (args[1] != "gauss-seidel")
+    {
+      std::fprintf(stderr,
+                   "contact_throughput: unknown solver %s\n",
+                   args[1].c_str());
+      return 1;
+    }
     args.erase(args.begin(), args.begin() + 2);
   }
   const int dim = (args.empty() ? 3 : std::atoi(args[0].c_str()));
@@ -222,9 +271,9 @@ main(int argc, char **argv)
   for (const unsigned int n : sizes)
   {
     if (dim == 2)
-      run<2>(n, friction);
+      run<2>(n, friction, method, shuffle);
     else
-      run<3>(n, friction);
+      run<3>(n, friction, method, shuffle);
   }
   return 0;
 }

@@ -61,6 +61,10 @@ namespace ImmersedGrains
                                "grain_substeps",
                                "clamped_fluid_fraction_nodes"})
         c.emplace_back(name);
+      // Appended: scripts may read the columns above by position.
+      c.emplace_back("fixed_particles");
+      for (int d = 0; d < dim; ++d)
+        c.push_back(std::string("fixed_centroid_") + axes[d]);
       return c;
     }
   } // namespace
@@ -576,6 +580,10 @@ namespace ImmersedGrains
       statistics.set(std::string("mean_velocity_") + axes[d],
                      s.mean_velocity[d]);
     }
+    statistics.set("fixed_particles", s.n_fixed);
+    for (unsigned int d = 0; d < dim; ++d)
+      statistics.set(std::string("fixed_centroid_") + axes[d],
+                     s.fixed_centroid[d]);
     statistics.set("max_speed", s.max_speed);
     statistics.set("kinetic_energy", s.kinetic_energy);
     statistics.set("packing_fraction", s.packing_fraction);

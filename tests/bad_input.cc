@@ -153,6 +153,31 @@ end
              "-0.5\nend\n",
          "Restitution",
          "-0.5"},
+        {"fixed_region_one_corner",
+         "set Dimension = 2\nsubsection Grains\n  set Fixed region = 0, "
+             "0\nend\n",
+         "Fixed region",
+         "0, 0"},
+        {"fixed_region_not_a_number",
+         "set Dimension = 2\nsubsection Grains\n  set Fixed region = 0, 0; "
+             "1, 0.2y\nend\n",
+         "Fixed region",
+         "0, 0; 1, 0.2y"},
+        {"fixed_region_wrong_dimension",
+         "set Dimension = 2\nsubsection Grains\n  set Fixed region = 0, 0, "
+             "0; 1, 1, 1\nend\n",
+         "Fixed region",
+         "0, 0, 0; 1, 1, 1"},
+        {"fixed_region_inverted",
+         "set Dimension = 2\nsubsection Grains\n  set Fixed region = 0, "
+             "0.5; 1, 0.25\nend\n",
+         "Fixed region",
+         "0, 0.5; 1, 0.25"},
+        {"fixed_region_with_fixed",
+         "set Dimension = 2\nsubsection Grains\n  set Fixed = true\n  set "
+             "Fixed region = 0, 0; 1, 0.25\nend\n",
+         "Fixed region",
+         "0, 0; 1, 0.25"},
         {"bad_test_check",
          "set Dimension = 2\nsubsection Output\n  set Test checks = "
              "kinetic_energy << 1\nend\n",

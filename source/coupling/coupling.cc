@@ -257,9 +257,9 @@ namespace ImmersedGrains
           GrainSample<dim> s;
           s.reference_location = p.get_reference_location();
           s.volume             = grain_volume<dim>(props[layout.radius]);
+          const bool fixed     = grains.is_fixed(p);
           for (unsigned int d = 0; d < dim; ++d)
-            s.velocity[d] =
-              grain_parameters.fixed ? 0.0 : props[layout.velocity + d];
+            s.velocity[d] = fixed ? 0.0 : props[layout.velocity + d];
           samples.push_back(s);
         }
       },
@@ -347,7 +347,7 @@ namespace ImmersedGrains
             arrays.contact_impulse[i].norm() > 0 &&
             c.velocity[i].norm() * (m + dt * gamma[i]) <=
               parameters.resting_threshold * arrays.contact_impulse[i].norm();
-          if (grain_parameters.fixed)
+          if (arrays.fixed[i])
           {
             drag.beta     = gamma[i];
             drag.velocity = 0;

@@ -1,4 +1,9 @@
+#include <deal.II/base/utilities.h>
+
 #include <immersed_grains/grains/grain_parameters.h>
+
+#include <cmath>
+#include <sstream>
 
 namespace ImmersedGrains
 {
@@ -41,8 +46,17 @@ namespace ImmersedGrains
       prm.declare_entry("Fixed",
                         "false",
                         Bool(),
-                        "The grains do not move (a fixed bed): infinite mass "
-                        "for the contact solver.");
+                        "Every grain is fixed (a fixed bed): it never moves "
+                        "and has infinite mass for the contact solver; to "
+                        "fix only some, see Fixed region.");
+      prm.declare_entry("Fixed region",
+                        "",
+                        Anything(),
+                        "A box 'x0,y0[,z0]; x1,y1[,z1]' (lower and upper "
+                        "corner): the grains whose centre lies in it when "
+                        "placed are fixed (infinite mass, never moved), the "
+                        "others move; e.g. a bed that moving grains are "
+                        "poured onto. Empty: none (unless Fixed = true).");
       prm.declare_entry("Max displacement fraction",
                         "0.125",
                         Double(0),
@@ -178,6 +192,79 @@ namespace ImmersedGrains
   }
 
 
+  namespace
+  {
+    /** Grains/Fixed region: two corners, or empty. */
+    template <int dim>
+    void
+    parse_fixed_region(GrainParameters<dim> &p, const InputLocation &where)
+    {
+      const std::string &text = p.fixed_region_text;
+      p.has_fixed_region      = false;
+      if (dealii::Utilities::trim(text).empty())
+        return;
+      // parse_point would name only one corner; the message names the whole
+      // entry.
+      const auto corners = dealii::Utilities::split_string_list(text, ';');
+      where.require(corners.size() == 2,
+                    "Fixed region",
+                    text,
+                    "expected two corners 'x0,y0" +
+                      std::string(dim == 3 ? ",z0" : "") + "; x1,y1" +
+                      std::string(dim == 3 ? ",z1" : "") + "'");
+      dealii::Point<dim> corner[2];
+      for (unsigned int c = 0; c < 2; ++c)
+      {
+        const auto values = dealii::Utilities::split_string_list(corners[c]);
+        where.require(values.size() == dim,
+                      "Fixed region",
+                      text,
+                      "corner '" + corners[c] + "' needs " +
+                        std::to_string(dim) + " comma-separated coordinates");
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          std::istringstream in(values[d]);
+          std::string        trailing;
+          where.require((in >> corner[c][d]) && !(in >> trailing) &&
+                          std::isfinite(corner[c][d]),
+                        "Fixed region",
+                        text,
+                        "'" + values[d] + "' is not a number");
+        }
+      }
+      for (unsigned int d = 0; d < dim; ++d)
+        where.require(corner[0][d] < corner[1][d],
+                      "Fixed region",
+                      text,
+                      "the first corner must lie below the second in every "
+                      "coordinate");
+      where.require(!p.fixed,
+                    "Fixed region",
+                    text,
+                    "Fixed = true already fixes every grain; set Fixed = "
+                    "false to fix only those in the region");
+      p.fixed_region_lower = corner[0];
+      p.fixed_region_upper = corner[1];
+      p.has_fixed_region   = true;
+    }
+  } // namespace
+
+
+  template <int dim>
+  bool
+  GrainParameters<dim>::fixed_at_placement(const dealii::Point<dim> &x) const
+  {
+    if (fixed)
+      return true;
+    if (!has_fixed_region)
+      return false;
+    for (unsigned int d = 0; d < dim; ++d)
+      if (x[d] < fixed_region_lower[d] || x[d] > fixed_region_upper[d])
+        return false;
+    return true;
+  }
+
+
   template <int dim>
   void
   GrainParameters<dim>::parse_parameters(dealii::ParameterHandler &prm,
@@ -223,7 +310,9 @@ namespace ImmersedGrains
                     "Density",
                     prm.get("Density"),
                     "must be positive");
-      fixed            = prm.get_bool("Fixed");
+      fixed             = prm.get_bool("Fixed");
+      fixed_region_text = prm.get("Fixed region");
+      parse_fixed_region(*this, where);
       max_displacement = prm.get_double("Max displacement fraction");
       where.require(max_displacement > 0,
                     "Max displacement fraction",

@@ -39,6 +39,8 @@ namespace ImmersedGrains
         l.fluid_force = add("fluid_force", dim, true);
       if (with_fluid && prm.contacts_enabled)
         l.contact_impulse = add("contact_impulse", dim, true);
+      if (prm.has_fixed_region)
+        l.fixed = add("fixed", 1, false);
       return l;
     }
   } // namespace
@@ -58,6 +60,7 @@ namespace ImmersedGrains
       , timer(timer)
       , properties(make_layout(parameters, with_fluid))
       , particles(tria, mapping, properties.n_properties)
+      , vertex_cache(tria, mapping)
   {
     if (parameters.contacts_enabled)
       contacts = std::make_unique<DistributedContacts<dim>>(geometry,
@@ -67,12 +70,79 @@ namespace ImmersedGrains
         parameters.gravity.norm() > 0)
       contacts->set_sweep_direction(-parameters.gravity /
                                     parameters.gravity.norm());
-    // Grains whose centre leaves the mesh where it is not open would vanish
-    // silently in the sort; move_and_scatter() prevents it, this counts any
-    // that slip through so that they are reported.
-    particles.signals.particle_lost.connect([this](const auto &, const auto &)
-                                            { ++lost; });
+    particles.signals.particle_lost.connect(
+      [this](const auto &particle, const auto &cell)
+      { rescue_lost_grain(particle, cell); });
     update_partition();
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::rescue_lost_grain(
+    const typename dealii::Particles::ParticleHandler<dim>::particle_iterator
+                                                                    &particle,
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell)
+  {
+    // The owned cells around the old one's vertices: where a grain that
+    // moved less than the cell bound of stable_time_step() can be.
+    const dealii::Point<dim> x      = particle->get_location();
+    const auto              &around = vertex_cache.get_vertex_to_cell_map();
+    double                   best   = std::numeric_limits<double>::max();
+    typename dealii::Triangulation<dim>::active_cell_iterator target;
+    dealii::Point<dim>                                        reference;
+    for (const unsigned int v : cell->vertex_indices())
+      for (const auto &candidate : around[cell->vertex_index(v)])
+      {
+        if (!candidate->is_locally_owned())
+          continue;
+        dealii::Point<dim> p;
+        try
+        {
+          p = mapping.transform_real_to_unit_cell(candidate, x);
+        }
+        catch (const typename dealii::Mapping<dim>::ExcTransformationFailed &)
+        {
+          // MappingQ1's Newton iteration can fail exactly at a vertex; the
+          // affine approximation is exact on box meshes and close enough
+          // on others for the test below.
+          p = candidate->real_to_unit_cell_affine_approximation(x);
+        }
+        const double distance =
+          dealii::GeometryInfo<dim>::distance_to_unit_cell(p);
+        if (distance < best)
+        {
+          best      = distance;
+          target    = candidate;
+          reference = p;
+        }
+      }
+    // Far below any motion the contact step resolves (a grain resting on a
+    // face moves by round-off of the contact solve, 1e-11 m was seen), far
+    // above the position error it leaves.
+    if (best > 1e-8)
+      return;
+    const auto props = particle->get_properties();
+    rescued.push_back(
+      {target,
+       x,
+       dealii::GeometryInfo<dim>::project_to_unit_cell(reference),
+       particle->get_id(),
+       std::vector<double>(props.begin(), props.end())});
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::reinsert(const std::vector<StoredGrain> &grains)
+  {
+    for (const StoredGrain &g : grains)
+      particles.insert_particle(g.location,
+                                g.reference,
+                                g.id,
+                                g.cell,
+                                dealii::ArrayView<const double>(
+                                  g.properties.data(), g.properties.size()));
   }
 
 
@@ -127,11 +197,13 @@ namespace ImmersedGrains
                       1e-12 * (1 + seeds[k].position.norm()),
                   dealii::ExcMessage("Grains: particle ids do not follow "
                                      "the order of insertion."));
-      auto props = p.get_properties();
+      auto       props = p.get_properties();
+      const bool fixed = parameters.fixed_at_placement(seeds[k].position);
       for (unsigned int d = 0; d < dim; ++d)
-        props[properties.velocity + d] =
-          parameters.fixed ? 0 : seeds[k].velocity[d];
+        props[properties.velocity + d] = fixed ? 0 : seeds[k].velocity[d];
       props[properties.radius] = seeds[k].radius;
+      if (properties.fixed != GrainPropertyLayout::absent)
+        props[properties.fixed] = fixed ? 1 : 0;
     }
     AssertThrow(particles.n_global_particles() == seeds.size(),
                 dealii::ExcMessage(
@@ -147,6 +219,17 @@ namespace ImmersedGrains
   Grains<dim>::mass(const double radius) const
   {
     return parameters.density * grain_volume<dim>(radius);
+  }
+
+
+  template <int dim>
+  bool
+  Grains<dim>::is_fixed(
+    const dealii::Particles::ParticleAccessor<dim> &particle) const
+  {
+    return parameters.fixed ||
+           (properties.fixed != GrainPropertyLayout::absent &&
+            particle.get_properties()[properties.fixed] != 0);
   }
 
 
@@ -211,6 +294,7 @@ namespace ImmersedGrains
     auto &c = arrays.contact;
     arrays.position.resize(n);
     arrays.mass.resize(n);
+    arrays.fixed.resize(n);
     c.velocity.resize(n);
     c.start_velocity.resize(n);
     c.inverse_mass.resize(n);
@@ -232,9 +316,10 @@ namespace ImmersedGrains
       arrays.position[i] = p.get_location();
       for (unsigned int d = 0; d < dim; ++d)
         c.velocity[i][d] = props[properties.velocity + d];
-      c.radius[i]    = props[properties.radius];
-      c.id[i]        = p.get_id();
-      arrays.mass[i] = mass(c.radius[i]);
+      c.radius[i]     = props[properties.radius];
+      c.id[i]         = p.get_id();
+      arrays.mass[i]  = mass(c.radius[i]);
+      arrays.fixed[i] = is_fixed(p);
       if (friction)
         for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
           c.angular_velocity[i][d] = props[properties.angular_velocity + d];
@@ -263,7 +348,7 @@ namespace ImmersedGrains
     for (unsigned int i = 0; i < n; ++i)
     {
       const double m = arrays.mass[i];
-      if (parameters.fixed)
+      if (arrays.fixed[i])
       {
         c.velocity[i]     = 0;
         c.inverse_mass[i] = 0;
@@ -387,19 +472,27 @@ namespace ImmersedGrains
   Grains<dim>::move_and_scatter(const double dt)
   {
     dealii::TimerOutput::Scope scope(timer, "grains: move and sort");
-    const auto                &c        = arrays.contact;
-    const bool                 friction = !c.angular_velocity.empty();
-    const auto                &lo       = geometry.lower_corner;
-    const auto                &hi       = geometry.upper_corner;
-    std::vector<
-      typename dealii::Particles::ParticleHandler<dim>::particle_iterator>
-                 leaving;
-    unsigned int i = 0;
+    using particle_iterator =
+      typename dealii::Particles::ParticleHandler<dim>::particle_iterator;
+    const auto &c        = arrays.contact;
+    const bool  friction = !c.angular_velocity.empty();
+    const auto &lo       = geometry.lower_corner;
+    const auto &hi       = geometry.upper_corner;
+    // Fixed grains keep their location bit for bit and are never sorted
+    // again: deal.II 9.4 re-sorts a grain whose reference coordinates
+    // are outside [0, 1] by round-off, and one sitting exactly on a mesh
+    // vertex was lost so. Where other grains move, the fixed ones leave
+    // the ParticleHandler during the sort and return to their cells.
+    std::vector<StoredGrain>       held;
+    std::vector<particle_iterator> leaving, taken_out;
+    unsigned long                  n_fixed = 0;
+    unsigned int                   i       = 0;
     for (auto p = particles.begin(); p != particles.end(); ++p, ++i)
     {
-      dealii::Point<dim> x    = arrays.position[i] + dt * c.velocity[i];
-      bool               left = false;
-      for (unsigned int d = 0; d < dim; ++d)
+      const bool         fixed = arrays.fixed[i];
+      dealii::Point<dim> x     = arrays.position[i] + dt * c.velocity[i];
+      bool               left  = false;
+      for (unsigned int d = 0; d < dim && !fixed; ++d)
       {
         const double L = hi[d] - lo[d];
         if (geometry.is_periodic(d))
@@ -429,10 +522,7 @@ namespace ImmersedGrains
         leaving.push_back(p);
         continue;
       }
-      // Fixed grains keep their location bit for bit: set again, a grain
-      // sitting exactly on a mesh vertex may not be found again by the
-      // sort below.
-      if (!parameters.fixed)
+      if (!fixed)
         p->set_location(x);
       auto props = p->get_properties();
       for (unsigned int d = 0; d < dim; ++d)
@@ -455,18 +545,45 @@ namespace ImmersedGrains
       if (friction)
         for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)
           props[properties.angular_velocity + d] = c.angular_velocity[i][d];
+      if (fixed)
+      {
+        ++n_fixed;
+        if (parameters.has_fixed_region)
+        {
+          held.push_back({p->get_surrounding_cell(),
+                          p->get_location(),
+                          p->get_reference_location(),
+                          p->get_id(),
+                          std::vector<double>(props.begin(), props.end())});
+          taken_out.push_back(p);
+        }
+      }
     }
-    particles.remove_particles(leaving);
-    const unsigned long count_before =
-      dealii::Utilities::MPI::sum<unsigned long>(
-        particles.n_locally_owned_particles(), comm);
-    if (!parameters.fixed)
+    const unsigned long n_leaving = leaving.size();
+    // Owned grains that stay, and the fixed ones among them, on all ranks.
+    std::vector<unsigned long> before = {particles.n_locally_owned_particles() -
+                                           n_leaving,
+                                         n_fixed};
+    dealii::Utilities::MPI::sum(before, comm, before);
+    if (before[1] == before[0])
+      // Nothing moves: no sort at all (Grains/Fixed = true).
+      particles.remove_particles(leaving);
+    else
+    {
+      leaving.insert(leaving.end(), taken_out.begin(), taken_out.end());
+      particles.remove_particles(leaving);
+      rescued.clear();
       particles.sort_particles_into_subdomains_and_cells();
+      reinsert(held);
+      reinsert(rescued);
+      // Collective (global counts): on every rank, held grains or not.
+      particles.update_cached_numbers();
+    }
     // A grain the ParticleHandler cannot place went through a wall or, under
     // MPI, farther than the ghost layer in one step: never drop it quietly.
     const unsigned long lost_now =
-      count_before - dealii::Utilities::MPI::sum<unsigned long>(
-                       particles.n_locally_owned_particles(), comm);
+      before[0] - dealii::Utilities::MPI::sum<unsigned long>(
+                    particles.n_locally_owned_particles(), comm);
     AssertThrow(lost_now == 0,
                 dealii::ExcMessage(
                   std::to_string(lost_now) +
@@ -475,7 +592,7 @@ namespace ImmersedGrains
                   std::to_string(dt) +
                   " s); reduce Time step or set Adaptive time step = true."));
     const unsigned long removed =
-      dealii::Utilities::MPI::sum<unsigned long>(leaving.size(), comm);
+      dealii::Utilities::MPI::sum<unsigned long>(n_leaving, comm);
     removed_total += removed;
     return removed;
   }
@@ -502,7 +619,8 @@ namespace ImmersedGrains
   Grains<dim>::compute_statistics() const
   {
     // Sums over owned grains: count, volume, sum x, sum v, kinetic energy,
-    // volume-weighted height along gravity; then one reduction.
+    // volume-weighted height along gravity, fixed grains' count and sum x;
+    // then one reduction. Fixed grains count in the means with v = 0.
     const bool friction =
       properties.angular_velocity != GrainPropertyLayout::absent;
     const dealii::Tensor<1, dim> down =
@@ -515,7 +633,8 @@ namespace ImmersedGrains
         axis = d;
     const double        floor = down[axis] < 0 ? geometry.lower_corner[axis] :
                                                  geometry.upper_corner[axis];
-    std::vector<double> sums(3 + 2 * dim + 1, 0.);
+    const unsigned int  fixed_sums = 3 + 2 * dim + 1;
+    std::vector<double> sums(fixed_sums + 1 + dim, 0.);
     double              max_speed = 0;
     for (const auto &p : particles)
     {
@@ -543,6 +662,12 @@ namespace ImmersedGrains
       // to), weighted by volume.
       sums[3 + 2 * dim] += V * std::abs(p.get_location()[axis] - floor);
       max_speed = std::max(max_speed, v.norm());
+      if (is_fixed(p))
+      {
+        sums[fixed_sums] += 1;
+        for (unsigned int d = 0; d < dim; ++d)
+          sums[fixed_sums + 1 + d] += p.get_location()[d];
+      }
     }
     dealii::Utilities::MPI::sum(sums, comm, sums);
 
@@ -557,6 +682,10 @@ namespace ImmersedGrains
         s.centroid[d]      = sums[3 + d] / s.n_grains;
         s.mean_velocity[d] = sums[3 + dim + d] / s.n_grains;
       }
+    s.n_fixed = sums[fixed_sums];
+    if (s.n_fixed > 0)
+      for (unsigned int d = 0; d < dim; ++d)
+        s.fixed_centroid[d] = sums[fixed_sums + 1 + d] / s.n_fixed;
     // Bulk packing fraction of a bed resting on the floor: its volume over
     // the cross-section times twice the volume-weighted centroid height
     // (exact for a uniform bed with a flat top).

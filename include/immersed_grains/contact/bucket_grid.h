@@ -96,9 +96,6 @@ namespace ImmersedGrains
       std::vector<double>               sorted_radius;
       std::vector<std::array<int, dim>> wrap_count;
       std::vector<unsigned int>         sort_buffer;
-      std::vector<unsigned int>         by_first;
-      std::vector<unsigned int>         sort_count;
-      std::vector<GrainPair<dim>>       unsorted_pairs;
 
       void
       choose_buckets(const unsigned int n_grains, const double min_size);
@@ -106,10 +103,6 @@ namespace ImmersedGrains
       void
       sort_grains_into_buckets(const std::vector<Point<dim>> &positions,
                                const std::vector<double>     &radii);
-
-      void
-      sort_pairs_by_index(const unsigned int           n_grains,
-                          std::vector<GrainPair<dim>> &pairs);
     };
   } // namespace Contact
 } // namespace ImmersedGrains

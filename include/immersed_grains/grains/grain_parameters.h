@@ -59,6 +59,15 @@ namespace ImmersedGrains
     double              density             = 2500;
     bool                fixed               = false;
     double              max_displacement    = 0.125; // of the smallest radius
+    /// Fixed region: grains whose centre lies in this closed box at
+    /// placement are fixed (a bed others fall onto); none if not set.
+    bool               has_fixed_region = false;
+    dealii::Point<dim> fixed_region_lower, fixed_region_upper;
+    std::string        fixed_region_text;
+
+    /** Whether a grain placed at @p x is fixed (Fixed, or Fixed region). */
+    bool
+    fixed_at_placement(const dealii::Point<dim> &x) const;
 
     // Grains/Placement
     PlacementShape                  shape = PlacementShape::list;

@@ -5,6 +5,7 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/fe/mapping_q1.h>
+#include <deal.II/grid/grid_tools_cache.h>
 #include <deal.II/numerics/data_component_interpretation.h>
 #include <deal.II/particles/particle_handler.h>
 
@@ -24,7 +25,8 @@ namespace ImmersedGrains
    * Where each quantity sits among a particle's properties. Only what the
    * scene needs is stored: velocity and radius always (the mass follows
    * from the one density), the angular velocity only with friction, the
-   * fluid force only with a fluid.
+   * fluid force only with a fluid, a fixed flag (1 or 0) only with a
+   * Grains/Fixed region (Fixed = true fixes all grains and needs none).
    */
   struct GrainPropertyLayout
   {
@@ -36,6 +38,7 @@ namespace ImmersedGrains
     unsigned int angular_velocity = absent;
     unsigned int fluid_force      = absent;
     unsigned int contact_impulse  = absent;
+    unsigned int fixed            = absent;
     unsigned int n_properties     = 0;
 
     /** Names and interpretations per component, for particle output. */
@@ -56,6 +59,8 @@ namespace ImmersedGrains
   {
     std::vector<dealii::Point<dim>> position;
     std::vector<double>             mass;
+    /** 1 for a fixed grain (never moved, infinite mass), else 0. */
+    std::vector<unsigned char> fixed;
 
     /** velocity: current on gather, free after compute_free_velocities(),
      *  end-of-step after resolve_contacts(). */
@@ -88,6 +93,10 @@ namespace ImmersedGrains
     double                 max_speed        = 0;
     double                 kinetic_energy   = 0;
     double                 packing_fraction = 0;
+    /** Fixed grains: their number and the mean of their centres (which
+     *  never change). */
+    double             n_fixed = 0;
+    dealii::Point<dim> fixed_centroid;
   };
 
   /** What one grain step did (global numbers). */
@@ -198,6 +207,11 @@ namespace ImmersedGrains
     double
     mass(double radius) const;
 
+    /** Whether @p particle is fixed (Grains/Fixed, or placed in the
+     *  Fixed region). */
+    bool
+    is_fixed(const dealii::Particles::ParticleAccessor<dim> &particle) const;
+
   private:
     const GrainParameters<dim>                              &parameters;
     const Geometry<dim>                                     &geometry;
@@ -205,9 +219,12 @@ namespace ImmersedGrains
     MPI_Comm                                                 comm;
     dealii::TimerOutput                                     &timer;
 
-    dealii::MappingQ1<dim>                             mapping;
-    GrainPropertyLayout                                properties;
-    dealii::Particles::ParticleHandler<dim>            particles;
+    dealii::MappingQ1<dim>                  mapping;
+    GrainPropertyLayout                     properties;
+    dealii::Particles::ParticleHandler<dim> particles;
+    /// Cells around each vertex, for rescue_lost_grain() (built on first
+    /// use, rebuilt when the mesh changes).
+    dealii::GridTools::Cache<dim>                      vertex_cache;
     std::unique_ptr<DistributedContacts<dim>>          contacts;
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
     /// Shortest edge of any active cell (update_partition()): the
@@ -217,7 +234,37 @@ namespace ImmersedGrains
 
     GrainStepArrays<dim> arrays;
     unsigned long        removed_total = 0;
-    unsigned long        lost          = 0;
+
+    /** A grain taken out of the ParticleHandler, to be put back into
+     *  @p cell as it was. */
+    struct StoredGrain
+    {
+      typename dealii::Triangulation<dim>::active_cell_iterator cell;
+      dealii::Point<dim>                                        location;
+      dealii::Point<dim>                                        reference;
+      dealii::types::particle_index                             id;
+      std::vector<double>                                       properties;
+    };
+    /// Grains deal.II's sort dropped although they lie in their old cell
+    /// up to round-off (see rescue_lost_grain()).
+    std::vector<StoredGrain> rescued;
+
+    /** particle_lost signal: deal.II 9.4 decides "inside a cell" without
+     *  tolerance, so a grain exactly on a face or vertex whose reference
+     *  coordinates come out a rounding error outside every adjacent cell
+     *  is dropped. Such a grain is kept for reinsertion into the owned
+     *  cell around the old one's vertices that it lies in up to 1e-8 in
+     *  reference coordinates (clamped into it); one that really left is
+     *  not, and move_and_scatter() reports it. */
+    void
+    rescue_lost_grain(
+      const typename dealii::Particles::ParticleHandler<dim>::particle_iterator
+                                                                      &particle,
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell);
+
+    /** Puts @p grains back into the ParticleHandler (local, no sort). */
+    void
+    reinsert(const std::vector<StoredGrain> &grains);
   };
 } // namespace ImmersedGrains
 
