@@ -6,6 +6,42 @@
 
 namespace ImmersedGrains
 {
+  namespace
+  {
+    // Replaces beta and beta u_p at the quadrature points by their cell
+    // means. A beta that jumps inside a cell gives a drag matrix of low
+    // rank there (sum over the few points inside of beta N_i N_j): the
+    // other modes of the cell stay viscous next to rows dominated by beta,
+    // which neither AMG nor the Schur approximation resolve
+    // (doc/benchmarks.md). The cell mean acts on all modes and keeps the
+    // cell's total drag coefficient and grain momentum.
+    template <int dim>
+    void
+    average_drag_over_cell(const dealii::FEValues<dim> &fe_values,
+                           MixtureValues<dim>          &mixture)
+    {
+      double                 beta = 0, volume = 0;
+      dealii::Tensor<1, dim> momentum;
+      for (const unsigned int q : fe_values.quadrature_point_indices())
+      {
+        const double JxW = fe_values.JxW(q);
+        beta += mixture.drag_coefficient[q] * JxW;
+        momentum +=
+          mixture.drag_coefficient[q] * mixture.grain_velocity[q] * JxW;
+        volume += JxW;
+      }
+      beta /= volume;
+      momentum /= volume;
+      for (const unsigned int q : fe_values.quadrature_point_indices())
+      {
+        mixture.drag_coefficient[q] = beta;
+        mixture.grain_velocity[q] =
+          beta > 0 ? momentum / beta : dealii::Tensor<1, dim>();
+      }
+    }
+  } // namespace
+
+
   /*
    * One loop over the cells builds the Jacobian (Picard: the Oseen
    * operator; Newton: plus the derivative of the advection term), minus
@@ -123,6 +159,8 @@ namespace ImmersedGrains
                                quadrature.get_points(),
                                time,
                                mixture);
+      if (parameters.cell_mean_drag)
+        average_drag_over_cell(fe_values, mixture);
       fe_values[velocities].get_function_values(solution, u);
       fe_values[velocities].get_function_gradients(solution, grad_u);
       fe_values[pressure].get_function_values(solution, p);

@@ -35,13 +35,16 @@ namespace ImmersedGrains
                      const std::string        &file,
                      const Geometry<dim>      &geometry);
 
-    bool         enabled                  = true;
-    double       density                  = 1.0;
-    double       viscosity                = 1.0;
-    bool         advection                = true;
-    bool         time_derivative          = true;
-    unsigned int bdf_order                = 2;
-    bool         newton                   = false;
+    bool         enabled         = true;
+    double       density         = 1.0;
+    double       viscosity       = 1.0;
+    bool         advection       = true;
+    bool         time_derivative = true;
+    unsigned int bdf_order       = 2;
+    bool         newton          = false;
+    // Integrate the continuum drag with its cell means (see the entry
+    // "Drag coefficient averaging").
+    bool         cell_mean_drag           = false;
     double       nonlinear_tolerance      = 1e-8;
     unsigned int max_nonlinear_iterations = 20;
 
