@@ -109,7 +109,9 @@ namespace ImmersedGrains
         "cells, 'quadrature' leaves velocity modes in the cut cells that "
         "the drag does not see, and the block preconditioner needs 5 to 30 "
         "times more iterations or does not converge; with 'cell' every mode "
-        "of a cell feels its drag (doc/benchmarks.md, the drag-jump cells).");
+        "of a cell feels its drag (doc/benchmarks.md, the drag-jump cells), "
+        "but for a smooth beta the velocity converges at second instead of "
+        "third order in L2.");
       prm.declare_entry("Linearization",
                         "Picard",
                         Selection("Picard|Newton"),
