@@ -269,6 +269,22 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  DragInput
+  Coupling<dim>::drag_input(const double                  radius,
+                            const double                  fluid_fraction,
+                            const dealii::Tensor<1, dim> &slip) const
+  {
+    return {radius,
+            projected_area<dim>(radius),
+            grain_volume<dim>(radius),
+            fluid_fraction,
+            slip.norm(),
+            density,
+            viscosity};
+  }
+
+
+  template <int dim>
   void
   Coupling<dim>::prepare_fluid_drag(const Grains<dim>      &grains,
                                     const FluidSolver<dim> &fluid,
@@ -319,14 +335,8 @@ namespace ImmersedGrains
           lagged_force[i] = -density * V * g;
           if (!implicit_velocity)
             lagged_force[i] -= V * fluid_values[k].pressure_gradient;
-          const dealii::Tensor<1, dim> slip = c.velocity[i] - felt[k];
-          const DragInput              in{r,
-                             projected_area<dim>(r),
-                             V,
-                             felt_fraction[k],
-                             slip.norm(),
-                             density,
-                             viscosity};
+          const DragInput in =
+            drag_input(r, felt_fraction[k], c.velocity[i] - felt[k]);
           gamma[i]     = drag_law->coefficient(in);
           reynolds_max = std::max(reynolds_max, DragLaw::reynolds(in));
 
@@ -483,15 +493,8 @@ namespace ImmersedGrains
           const double V = grain_volume<dim>(c.radius[i]);
           if (!as_predicted)
           {
-            const double    r = c.radius[i];
-            const DragInput in{r,
-                               projected_area<dim>(r),
-                               V,
-                               felt_fraction[k],
-                               (c.velocity[i] - u).norm(),
-                               density,
-                               viscosity};
-            gamma[i]        = drag_law->coefficient(in);
+            gamma[i] = drag_law->coefficient(
+              drag_input(c.radius[i], felt_fraction[k], c.velocity[i] - u));
             lagged_force[i] = -density * V * g;
           }
           arrays.external_force[i] = lagged_force[i];

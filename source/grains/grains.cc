@@ -258,6 +258,14 @@ namespace ImmersedGrains
     r_min = dealii::Utilities::MPI::min(r_min, comm);
     if (v_max <= 0 || parameters.fixed)
       return max_step;
+    return std::min(max_step, longest_step(v_max, r_min));
+  }
+
+
+  template <int dim>
+  double
+  Grains<dim>::longest_step(const double v_max, const double r_min) const
+  {
     // The ParticleHandler looks for a moved grain in the cells around its
     // old cell; under MPI those are the owned and ghost cells, so a grain
     // that moves farther in one step is lost (move_and_scatter() stops the
@@ -266,8 +274,7 @@ namespace ImmersedGrains
     // (1 + e) times the speed of the grain that hits it.
     const double cell_bound =
       0.5 * min_cell_size / ((1 + parameters.contact.restitution) * v_max);
-    return std::min(
-      {max_step, parameters.max_displacement * r_min / v_max, cell_bound});
+    return std::min(parameters.max_displacement * r_min / v_max, cell_bound);
   }
 
 
@@ -396,11 +403,8 @@ namespace ImmersedGrains
     if (v_max <= 0)
       return 1;
     // The bounds of stable_time_step(), with the velocities of this step.
-    const double step =
-      std::min(parameters.max_displacement * r_min / v_max,
-               0.5 * min_cell_size /
-                 ((1 + parameters.contact.restitution) * v_max));
-    return std::max(1., std::ceil(dt / step * (1 - 1e-12)));
+    return std::max(1.,
+                    std::ceil(dt / longest_step(v_max, r_min) * (1 - 1e-12)));
   }
 
 

@@ -181,6 +181,12 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>> &references) const;
 
+    /// What the drag law needs of a grain of @p radius.
+    DragInput
+    drag_input(double                        radius,
+               double                        fluid_fraction,
+               const dealii::Tensor<1, dim> &slip) const;
+
     /// The grains' hooks: @p as_predicted for the first (or only) grain
     /// step, with gamma and the force the fluid's prediction used.
     void

@@ -213,6 +213,12 @@ namespace ImmersedGrains
     is_fixed(const dealii::Particles::ParticleAccessor<dim> &particle) const;
 
   private:
+    /// The longest step in which no grain at speed up to @p v_max moves
+    /// more than the Max displacement fraction of @p r_min or half the
+    /// shortest cell edge.
+    double
+    longest_step(double v_max, double r_min) const;
+
     const GrainParameters<dim>                              &parameters;
     const Geometry<dim>                                     &geometry;
     const dealii::parallel::distributed::Triangulation<dim> &triangulation;
