@@ -99,19 +99,23 @@ namespace ImmersedGrains
                         "variable step (the first step is BDF1).");
       prm.declare_entry(
         "Drag coefficient averaging",
-        "quadrature",
-        Selection("quadrature|cell"),
+        "jump",
+        Selection("jump|quadrature|cell"),
         "How the continuum drag beta (u - u_p) (prescribed, or filtered "
         "from the grains) is integrated: 'quadrature' with beta and u_p at "
         "each quadrature point; 'cell' with beta and beta u_p replaced by "
         "their means over each cell (same total drag coefficient and grain "
-        "momentum per cell). Where beta jumps by orders of magnitude inside "
-        "cells, 'quadrature' leaves velocity modes in the cut cells that "
-        "the drag does not see, and the block preconditioner needs 5 to 30 "
-        "times more iterations or does not converge; with 'cell' every mode "
-        "of a cell feels its drag (doc/benchmarks.md, the drag-jump cells), "
-        "but for a smooth beta the velocity converges at second instead of "
-        "third order in L2.");
+        "momentum per cell); 'jump' with the cell means only in the cells "
+        "where beta jumps, (beta_max h^2 + phi mu)/(beta_min h^2 + phi mu) > "
+        "10 over the cell's quadrature points, and at the quadrature points "
+        "elsewhere. Where beta jumps by orders of magnitude inside cells, "
+        "'quadrature' leaves velocity modes in the cut cells that the drag "
+        "does not see, and the block preconditioner needs 5 to 30 times "
+        "more iterations or does not converge; with 'cell' every mode of a "
+        "cell feels its drag (doc/benchmarks.md, the drag-jump cells), but "
+        "for a smooth beta the velocity converges at second instead of "
+        "third order in L2. 'jump' converges like 'cell' on jumps and keeps "
+        "the third order of 'quadrature' where beta is smooth on the mesh.");
       prm.declare_entry("Linearization",
                         "Picard",
                         Selection("Picard|Newton"),
@@ -199,12 +203,17 @@ namespace ImmersedGrains
                     "Viscosity",
                     prm.get("Viscosity"),
                     "must be positive");
-      advection           = prm.get_bool("Advection");
-      time_derivative     = prm.get_bool("Time derivative");
-      bdf_order           = prm.get("Time scheme") == "BDF2" ? 2 : 1;
-      newton              = prm.get("Linearization") == "Newton";
-      cell_mean_drag      = prm.get("Drag coefficient averaging") == "cell";
-      nonlinear_tolerance = prm.get_double("Nonlinear tolerance");
+      advection       = prm.get_bool("Advection");
+      time_derivative = prm.get_bool("Time derivative");
+      bdf_order       = prm.get("Time scheme") == "BDF2" ? 2 : 1;
+      newton          = prm.get("Linearization") == "Newton";
+      {
+        const std::string averaging = prm.get("Drag coefficient averaging");
+        drag_averaging = averaging == "cell" ? DragAveraging::cell :
+                         averaging == "jump" ? DragAveraging::jump :
+                                               DragAveraging::quadrature;
+      }
+      nonlinear_tolerance      = prm.get_double("Nonlinear tolerance");
       max_nonlinear_iterations = prm.get_integer("Max nonlinear iterations");
 
       prm.enter_subsection("Linear solver");

@@ -42,9 +42,18 @@ namespace ImmersedGrains
     bool         time_derivative = true;
     unsigned int bdf_order       = 2;
     bool         newton          = false;
-    // Integrate the continuum drag with its cell means (see the entry
-    // "Drag coefficient averaging").
-    bool         cell_mean_drag           = false;
+    // How the continuum drag is integrated (the entry "Drag coefficient
+    // averaging").
+    enum class DragAveraging
+    {
+      quadrature,
+      cell,
+      jump
+    };
+    DragAveraging drag_averaging = DragAveraging::jump;
+    // With 'jump', the contrast (beta_max h^2 + phi mu)/(beta_min h^2 +
+    // phi mu) inside a cell above which its drag is averaged.
+    double       drag_jump_contrast       = 10;
     double       nonlinear_tolerance      = 1e-8;
     unsigned int max_nonlinear_iterations = 20;
 
