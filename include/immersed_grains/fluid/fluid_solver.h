@@ -144,6 +144,11 @@ namespace ImmersedGrains
     unsigned int
     solve_linear_system(double absolute_tolerance);
 
+    // |A x + r| over the unconstrained rows, with A and r = system_rhs as
+    // assembled at the iterate x: the size of the right-hand side.
+    double
+    right_hand_side_norm(const VectorType &iterate) const;
+
     void
     build_preconditioner();
 
