@@ -160,14 +160,14 @@ run(const unsigned int level_min,
         FluidParameters<dim> parameters;
         parameters.parse_parameters(prm, "benchmark", geometry);
 
-        const double h      = 1.0 / (1 << level);
+        const double h = 1.0 / (1 << level);
         // FLUID_BENCH_BETA_FIXED=1: the listed values are beta L^2/mu with
         // L = 1 the box, the same physical drag on every level, instead of
         // beta h^2/mu, which grows beta fourfold per level.
         const double beta =
           beta_scaled * parameters.viscosity /
           (std::getenv("FLUID_BENCH_BETA_FIXED") != nullptr ? 1.0 : h * h);
-        auto         fields = std::make_shared<PrescribedMixtureFields<dim>>(
+        auto fields = std::make_shared<PrescribedMixtureFields<dim>>(
           std::make_shared<JumpField<dim>>(0.35, 1.0),
           std::make_shared<JumpField<dim>>(beta, 0.0),
           std::make_shared<Functions::ZeroFunction<dim>>(dim));

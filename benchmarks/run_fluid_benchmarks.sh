@@ -2,10 +2,11 @@
 # Fluid solver benchmarks for doc/benchmarks.md:
 #  1. preconditioner robustness: outer FGMRES iterations over mesh levels,
 #     time steps, drag and a jumping fluid fraction (2D levels 3..7, 3D 2..4),
-#     with the drag integrated at quadrature points (default) and with its
-#     cell means (`Drag coefficient averaging = cell`); LARGE=1 adds 3D
-#     level 5 (several GiB; the default without the 1e8 cells, which do not
-#     converge and would take hours); INNER=1 the inner-GMRES variant;
+#     with the default `Drag coefficient averaging = jump` (cell means in the
+#     cells the jump cuts), with the drag at the quadrature points
+#     (`quadrature`, the default before) and with the same physical drag on
+#     every level (FIXED=1); LARGE=1 adds 3D level 5 (several GiB);
+#     INNER=1 the inner-GMRES variant;
 #  2. what switching physics off saves: the same scene solved as
 #     Navier-Stokes/BDF2, Stokes/BDF2 and steady Stokes.
 # Usage: benchmarks/run_fluid_benchmarks.sh [OUTDIR]  (after scripts/setup.sh)
@@ -19,12 +20,14 @@ cmake --build build --target benchmarks -j"$(nproc)" >/dev/null
 bin=build/benchmarks/fluid_preconditioner
 $bin 2 3 7 > "$out/preconditioner_2d.md"
 $bin 3 2 4 > "$out/preconditioner_3d.md"
-FLUID_BENCH_DRAG_AVERAGING=cell $bin 2 3 7 > "$out/preconditioner_2d_cell.md"
-FLUID_BENCH_DRAG_AVERAGING=cell $bin 3 2 4 > "$out/preconditioner_3d_cell.md"
+FLUID_BENCH_DRAG_AVERAGING=quadrature FLUID_BENCH_BETA=0,1,1e4 \
+  $bin 2 3 7 > "$out/preconditioner_2d_quadrature.md"
+if [ "${FIXED:-0}" = 1 ]; then
+  FLUID_BENCH_BETA_FIXED=1 FLUID_BENCH_DT=steady,1 FLUID_BENCH_BETA=1e2,1e4,1e6 \
+    $bin 2 3 7 > "$out/preconditioner_2d_fixed_beta.md"
+fi
 if [ "${LARGE:-0}" = 1 ]; then
-  FLUID_BENCH_BETA=0,1,1e4 $bin 3 5 5 > "$out/preconditioner_3d_level5.md"
-  FLUID_BENCH_DRAG_AVERAGING=cell $bin 3 5 5 \
-    > "$out/preconditioner_3d_level5_cell.md"
+  FLUID_BENCH_DT=1,steady,1e-4 $bin 3 5 5 > "$out/preconditioner_3d_level5.md"
 fi
 # INNER=1: the drag-jump columns with the inner GMRES on the velocity block
 # (doc/benchmarks.md, "The drag-jump cells").
