@@ -65,6 +65,7 @@ namespace ImmersedGrains
       c.emplace_back("fixed_particles");
       for (int d = 0; d < dim; ++d)
         c.push_back(std::string("fixed_centroid_") + axes[d]);
+      c.emplace_back("drag_averaged_cells");
       return c;
     }
   } // namespace
@@ -401,6 +402,7 @@ namespace ImmersedGrains
       fluid_iterations = stats.linear_iterations;
       statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
       statistics.set("fluid_residual", stats.final_residual);
+      statistics.set("drag_averaged_cells", stats.drag_averaged_cells);
     }
     if (grains && !coupling)
       record_grain_step(grains->advance(dt));
@@ -450,6 +452,7 @@ namespace ImmersedGrains
     fluid_iterations = stats.linear_iterations;
     statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
     statistics.set("fluid_residual", stats.final_residual);
+    statistics.set("drag_averaged_cells", stats.drag_averaged_cells);
     coupling->set_grain_forces(*grains, *fluid, dt);
     grains->compute_free_velocities(dt);
     // Grains that this step would move too far take equal sub-steps

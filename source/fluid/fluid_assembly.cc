@@ -159,7 +159,8 @@ namespace ImmersedGrains
     forcing->set_time(time);
     parameters.open_boundary_pressure->set_time(time);
 
-    double max_beta = 0;
+    double       max_beta       = 0;
+    unsigned int averaged_cells = 0;
 
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
@@ -192,7 +193,10 @@ namespace ImmersedGrains
                               std::pow(cell->measure(), 1.0 / dim),
                               mu,
                               parameters.drag_jump_contrast)))
+      {
         average_drag_over_cell(fe_values, mixture);
+        ++averaged_cells;
+      }
       fe_values[velocities].get_function_values(solution, u);
       fe_values[velocities].get_function_gradients(solution, grad_u);
       fe_values[pressure].get_function_values(solution, p);
@@ -403,6 +407,8 @@ namespace ImmersedGrains
 
     system_matrix.compress(dealii::VectorOperation::add);
     system_rhs.compress(dealii::VectorOperation::add);
+    drag_averaged_cells =
+      dealii::Utilities::MPI::sum(averaged_cells, mpi_communicator);
     if (assemble_preconditioner_matrices)
     {
       pressure_mass_matrix.compress(dealii::VectorOperation::add);

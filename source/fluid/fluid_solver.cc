@@ -543,6 +543,7 @@ namespace ImmersedGrains
         break;
       }
     }
+    stats.drag_averaged_cells = drag_averaged_cells;
     AssertThrow(converged,
                 dealii::ExcMessage(
                   "Fluid: the nonlinear iteration did not converge in " +

@@ -110,6 +110,11 @@ namespace ImmersedGrains
       unsigned int linear_iterations    = 0; // summed over nonlinear steps
       double       initial_residual     = 0;
       double       final_residual       = 0;
+      // Cells whose drag was integrated with its cell means (the entry
+      // "Drag coefficient averaging"); there the fluid feels the mean
+      // drag coefficient against its own velocity, not the drag that a
+      // filtered grain drag gives the grains.
+      unsigned int drag_averaged_cells = 0;
     };
 
     /** Advances from the current time to @p new_time = time + dt. */
@@ -209,6 +214,7 @@ namespace ImmersedGrains
     std::shared_ptr<const PointDragSource<dim>> point_drag_source;
     bool                                        cell_averaged_drag = false;
     double                                      force_scale        = 0;
+    unsigned int drag_averaged_cells = 0; // in the last assembly
     // |(integral of N_i)_i| over the first velocity component's DoFs: the
     // load vector norm of a unit force per unit volume (setup_dofs).
     double                                 unit_load_norm = 0;
