@@ -27,6 +27,11 @@ namespace ImmersedGrains
       data.smoother_type         = "ILU";
       data.smoother_sweeps       = 2;
       data.aggregation_threshold = 0.02;
+      // Each rank's ILU sees one layer of its neighbours' rows: where drag
+      // dominates, the drag's own mass-matrix couplings cross the rank
+      // boundary, and without the overlap 2 ranks needed 34-51 iterations
+      // where 1 needs 16-28 (doc/benchmarks.md, "On two ranks").
+      data.smoother_overlap      = 1;
       velocity_amg.initialize(system_matrix.block(0, 0), data);
     }
     if (pressure_mass != nullptr)
