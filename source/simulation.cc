@@ -277,8 +277,6 @@ namespace ImmersedGrains
         fluid_parameters, geometry, triangulation, *timer, pcout);
       fluid->setup_dofs();
       fluid->set_initial_condition();
-      fluid->set_force_scale(fluid_parameters.density *
-                             grain_parameters.gravity.norm());
       pcout << "  fluid: "
             << (fluid_parameters.advection ? "Navier-Stokes" : "Stokes")
             << (fluid_parameters.time_derivative ?

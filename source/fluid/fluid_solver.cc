@@ -245,14 +245,6 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  FluidSolver<dim>::set_force_scale(const double force_per_volume)
-  {
-    force_scale = force_per_volume;
-  }
-
-
-  template <int dim>
-  void
   FluidSolver<dim>::setup_dofs()
   {
     dealii::TimerOutput::Scope scope(timer, "fluid: setup");
@@ -318,41 +310,6 @@ namespace ImmersedGrains
     newton_update.reinit(owned_partitioning, mpi_communicator);
     preconditioner.reset();
     schur_diagonal_matrix.clear();
-
-    unit_load_norm = compute_unit_load_norm();
-  }
-
-
-  template <int dim>
-  double
-  FluidSolver<dim>::compute_unit_load_norm() const
-  {
-    // Load vector of a unit force per unit volume along x (constraints
-    // left aside: a scale, not an equation).
-    VectorType                load(owned_partitioning, mpi_communicator);
-    const dealii::QGauss<dim> quadrature(fe.degree + 1);
-    dealii::FEValues<dim>     fe_values(mapping,
-                                    fe,
-                                    quadrature,
-                                    dealii::update_values |
-                                      dealii::update_JxW_values);
-    dealii::Vector<double>    cell_load(fe.n_dofs_per_cell());
-    std::vector<dealii::types::global_dof_index> indices(fe.n_dofs_per_cell());
-    const dealii::AffineConstraints<double>      no_constraints;
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-      {
-        fe_values.reinit(cell);
-        cell->get_dof_indices(indices);
-        cell_load = 0;
-        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
-          if (fe.system_to_component_index(i).first == 0)
-            for (const unsigned int q : fe_values.quadrature_point_indices())
-              cell_load(i) += fe_values.shape_value(i, q) * fe_values.JxW(q);
-        no_constraints.distribute_local_to_global(cell_load, indices, load);
-      }
-    load.compress(dealii::VectorOperation::add);
-    return load.l2_norm();
   }
 
 
@@ -576,7 +533,7 @@ namespace ImmersedGrains
           b.block(block)[i] = 0;
     }
     b.compress(dealii::VectorOperation::insert);
-    return std::max(b.l2_norm(), force_scale * unit_load_norm);
+    return b.l2_norm();
   }
 
 

@@ -93,17 +93,6 @@ namespace ImmersedGrains
     void
     set_boundary_velocity(std::shared_ptr<dealii::Function<dim>> velocity);
 
-    /**
-     * A force per unit volume [N/m^3] typical of the scene (the simulation
-     * passes rho_f |g|, the hydrostatic gradient taken out of the
-     * pressure). A residual below Tolerance times its load vector counts
-     * as solved even where the right-hand side itself is round-off (a
-     * fluid at rest around grains at rest); zero, the default, keeps only
-     * the right-hand side's own size.
-     */
-    void
-    set_force_scale(double force_per_volume);
-
     struct StepStatistics
     {
       unsigned int nonlinear_iterations = 0;
@@ -161,13 +150,9 @@ namespace ImmersedGrains
     solve_linear_system(double absolute_tolerance);
 
     // |A x + r| over the unconstrained rows, with A and r = system_rhs as
-    // assembled at the iterate x: the size of the right-hand side, at
-    // least that of the force scale's load vector.
+    // assembled at the iterate x: the size of the right-hand side.
     double
     right_hand_side_norm(const VectorType &iterate) const;
-
-    double
-    compute_unit_load_norm() const;
 
     void
     build_preconditioner();
@@ -213,11 +198,7 @@ namespace ImmersedGrains
     std::shared_ptr<const MixtureFields<dim>>   mixture_fields;
     std::shared_ptr<const PointDragSource<dim>> point_drag_source;
     bool                                        cell_averaged_drag = false;
-    double                                      force_scale        = 0;
     unsigned int drag_averaged_cells = 0; // in the last assembly
-    // |(integral of N_i)_i| over the first velocity component's DoFs: the
-    // load vector norm of a unit force per unit volume (setup_dofs).
-    double                                 unit_load_norm = 0;
     std::shared_ptr<dealii::Function<dim>> forcing;
     std::shared_ptr<dealii::Function<dim>> boundary_velocity;
 
