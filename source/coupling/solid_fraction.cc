@@ -140,17 +140,18 @@ namespace ImmersedGrains
                                       dealii::update_values |
                                         dealii::update_JxW_values);
       std::vector<double>       values(quadrature.size());
+      dealii::Vector<double>    cell_rhs(n);
       for (const auto &cell : filter.get_dof_handler().active_cell_iterators())
         if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
           fe_values.get_function_values(fraction, values);
-          cell_volume = 0;
+          cell_rhs = 0;
           for (unsigned int q = 0; q < quadrature.size(); ++q)
             for (unsigned int j = 0; j < n; ++j)
-              cell_volume(j) +=
+              cell_rhs(j) +=
                 values[q] * fe_values.shape_value(j, q) * fe_values.JxW(q);
-          filter.add_cell_contribution(cell, cell_volume, indices, felt_rhs);
+          filter.add_cell_contribution(cell, cell_rhs, indices, felt_rhs);
         }
       felt_rhs.compress(dealii::VectorOperation::add);
       filter.solve(felt_rhs, felt);

@@ -31,7 +31,7 @@ namespace ImmersedGrains
       // dominates, the drag's own mass-matrix couplings cross the rank
       // boundary, and without the overlap 2 ranks needed 34-51 iterations
       // where 1 needs 16-28 (doc/benchmarks.md, "On two ranks").
-      data.smoother_overlap      = 1;
+      data.smoother_overlap = 1;
       velocity_amg.initialize(system_matrix.block(0, 0), data);
     }
     if (pressure_mass != nullptr)
