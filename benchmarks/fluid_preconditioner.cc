@@ -152,7 +152,10 @@ run(const unsigned int level_min,
           "\n set Time scheme = BDF1\n subsection Linear solver\n"
           "  set Tolerance = 1e-8\n  set Max iterations = 1000\n"
           "  set Schur complement = " +
-          schur + "\n  set Velocity AMG cycles = " + std::to_string(cycles) +
+          schur +
+          (cycles > 0 ?
+             "\n  set Velocity AMG cycles = " + std::to_string(cycles) :
+             std::string()) +
           "\n" + extra_entries + " end\nend\n");
         Geometry<dim> geometry;
         geometry.parse_parameters(prm, "benchmark");
@@ -241,7 +244,7 @@ main(int argc, char **argv)
   const unsigned int lmax     = std::atoi(argv[3]);
   const bool        advection = argc > 4 && std::string(argv[4]) == "advection";
   const std::string schur     = argc > 5 ? argv[5] : "Cahouet-Chabard";
-  const unsigned int cycles   = argc > 6 ? std::atoi(argv[6]) : 1;
+  const unsigned int cycles   = argc > 6 ? std::atoi(argv[6]) : 0;
   const std::string  extra    = argc > 7 ? argv[7] : "";
   if (dim == 2)
     run<2>(lmin, lmax, advection, schur, cycles, extra);

@@ -3,9 +3,10 @@
 // square, no drag outside, a swirling body force, Stokes with dt = 1 and
 // steady. With `Drag coefficient averaging = cell`, and with the default
 // `jump` (cell means only in the cells the jump cuts), FGMRES must converge
-// within 40 iterations at levels 4 and 5 (the quadrature-point drag needs
-// up to 181 at level 5, doc/benchmarks.md; both averagings measured 16 and
-// 28 there); the test prints whether it did, not the counts, which vary a
+// within 30 iterations (the goal) at levels 4 and 5 (the
+// quadrature-point drag needs up to 181 at level 5, doc/benchmarks.md; the
+// default solver measures 12-25 there); the test prints whether it did,
+// not the counts, which vary a
 // little between Trilinos versions. It also prints how many cells had their
 // drag averaged: every cell with 'cell'; with 'jump' exactly the cells that
 // the circle cuts (those whose quadrature points lie on both sides: 36 and
@@ -79,7 +80,7 @@ main(int argc, char **argv)
                       " set Viscosity = 1\n set Advection = false\n") +
           averaging_entry + " set Time scheme = BDF1\n set Time derivative = " +
           (dt > 0 ? "true" : "false") +
-          "\n subsection Linear solver\n  set Max iterations = 40\n "
+          "\n subsection Linear solver\n  set Max iterations = 30\n "
           "end\nend\n");
         Geometry<2> geometry;
         geometry.parse_parameters(prm, "drag_jump");
@@ -119,8 +120,8 @@ main(int argc, char **argv)
                       averaging.c_str(),
                       level,
                       dt > 0 ? "dt = 1" : "steady",
-                      converged ? "converged within 40 iterations" :
-                                  "NOT converged within 40 iterations",
+                      converged ? "converged within 30 iterations" :
+                                  "NOT converged within 30 iterations",
                       averaged_cells,
                       tria.n_global_active_cells());
       }

@@ -40,19 +40,21 @@ namespace ImmersedGrains
       // dominated by its mass and drag part c M, whatever the jumps in c
       // (= phi rho a0/dt + beta); a Darcy-like operator on the pressure.
       // Where c vanishes (viscous regions of a steady problem) the term
-      // must vanish from S~^{-1}: a hundredth of the rest of diag(A)
-      // keeps the inverse finite while making S_c large there. The
-      // factor is a measured compromise (doc/benchmarks.md): smaller
-      // values leave a large coefficient contrast for AMG, larger ones
-      // over-count the viscous part.
+      // must vanish from S~^{-1}: a floor on c (assembled with A, see
+      // schur_floor_factor in fluid_assembly.cc) keeps the inverse finite
+      // while making S_c large there. Rows without one (constrained
+      // velocities, whose B^T rows are empty) keep a hundredth of A's
+      // diagonal.
       const auto                           &A = system_matrix.block(0, 0);
       dealii::TrilinosWrappers::MPI::Vector inverse_diagonal(
         owned_partitioning[0], mpi_communicator);
       for (const auto i : owned_partitioning[0])
       {
         const double reaction = reaction_diagonal.block(0)[i];
-        const double rest     = std::abs(A.diag_element(i) - reaction);
-        inverse_diagonal[i]   = 1.0 / (reaction + 1e-2 * rest);
+        const double floor    = schur_floor_diagonal.block(0)[i];
+        inverse_diagonal[i] =
+          1.0 /
+          (reaction + (floor > 0 ? floor : 1e-2 * std::abs(A.diag_element(i))));
       }
       inverse_diagonal.compress(dealii::VectorOperation::insert);
       dealii::TrilinosWrappers::SparseMatrix product;
@@ -64,8 +66,13 @@ namespace ImmersedGrains
       // empty rows in the product; AMG needs a diagonal everywhere. So the
       // matrix handed on has the product's pattern plus the diagonal (built
       // once per mesh), empty rows get the mean diagonal, and without an
-      // open face a shift of a millionth of that mean removes the constant
-      // null space for AMG's coarse solve.
+      // open face every diagonal entry grows by a millionth of itself,
+      // which removes the constant null space for AMG's coarse solve. The
+      // shift must be relative: S_c's diagonal spans the contrast of c
+      // (10^10 and more between clear fluid and a packed bed), and a
+      // millionth of the mean diagonal swamped the rows of the drag
+      // region, where S_c^{-1} then lost its Darcy term
+      // (doc/benchmarks.md, fifth round: 186 instead of 33 iterations).
       if (schur_diagonal_matrix.m() != product.m())
       {
         dealii::TrilinosWrappers::SparsityPattern pattern(owned_partitioning[1],
@@ -107,11 +114,11 @@ namespace ImmersedGrains
       schur_diagonal_matrix.compress(dealii::VectorOperation::add);
       mean = dealii::Utilities::MPI::sum(mean, mpi_communicator) /
              std::max(1u, dealii::Utilities::MPI::sum(n, mpi_communicator));
-      const double shift = pressure_has_null_space() ? 1e-6 * mean : 0.0;
+      const double shift = pressure_has_null_space() ? 1e-6 : 0.0;
       for (const auto i : owned_partitioning[1])
       {
         const double d = schur_diagonal_matrix.diag_element(i);
-        schur_diagonal_matrix.set(i, i, d == 0 ? mean : d + shift);
+        schur_diagonal_matrix.set(i, i, d == 0 ? mean : d * (1 + shift));
       }
       schur_diagonal_matrix.compress(dealii::VectorOperation::insert);
     }

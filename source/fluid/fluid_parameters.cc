@@ -148,10 +148,12 @@ namespace ImmersedGrains
           "drag-dominated limit; a Darcy-like pressure Laplacian), as "
           "Cahouet-Chabard do, or either limit alone.");
         prm.declare_entry("Velocity AMG cycles",
-                          "1",
+                          "2",
                           Integer(1, 10),
                           "AMG V-cycles per application of the velocity "
-                          "block's inverse.");
+                          "block's inverse. Two keep the outer iterations "
+                          "bounded on fine meshes for about the time of "
+                          "one (doc/benchmarks.md).");
         prm.declare_entry(
           "Velocity inner iterations",
           "0",

@@ -31,7 +31,7 @@ namespace ImmersedGrains
 
     struct Settings
     {
-      unsigned int velocity_cycles = 1;
+      unsigned int velocity_cycles = 2;
 
       // If positive: A~^{-1} is up to this many GMRES iterations
       // preconditioned by one V-cycle, stopped early at a relative residual

@@ -62,7 +62,7 @@ namespace ImmersedGrains
     unsigned int       max_linear_iterations = 500;
     SchurApproximation schur_approximation =
       SchurApproximation::cahouet_chabard;
-    unsigned int velocity_amg_cycles       = 1;
+    unsigned int velocity_amg_cycles       = 2;
     unsigned int velocity_inner_iterations = 0;
     double       velocity_inner_tolerance  = 1e-6;
 
