@@ -152,8 +152,8 @@ namespace ImmersedGrains
                           Integer(1, 10),
                           "AMG V-cycles per application of the velocity "
                           "block's inverse. Two keep the outer iterations "
-                          "bounded on fine meshes for about the time of "
-                          "one (doc/benchmarks.md).");
+                          "bounded on fine meshes; one is cheaper where mass "
+                          "dominates (doc/benchmarks.md).");
         prm.declare_entry(
           "Velocity inner iterations",
           "0",
