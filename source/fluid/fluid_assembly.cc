@@ -118,7 +118,6 @@ namespace ImmersedGrains
     {
       pressure_mass_matrix = 0;
       reaction_diagonal    = 0;
-      schur_floor_diagonal = 0;
     }
 
     const dealii::QGauss<dim>     quadrature(fe.degree + 1);
@@ -154,7 +153,6 @@ namespace ImmersedGrains
     dealii::FullMatrix<double> cell_mass(dofs_per_cell, dofs_per_cell);
     dealii::Vector<double>     cell_rhs(dofs_per_cell);
     dealii::Vector<double>     cell_reaction(dofs_per_cell);
-    dealii::Vector<double>     cell_floor(dofs_per_cell);
     double                     box_size = std::numeric_limits<double>::max();
     for (unsigned int d = 0; d < dim; ++d)
       box_size =
@@ -205,7 +203,6 @@ namespace ImmersedGrains
       {
         cell_mass     = 0;
         cell_reaction = 0;
-        cell_floor    = 0;
       }
 
       mixture_fields->evaluate(cell,
@@ -213,15 +210,12 @@ namespace ImmersedGrains
                                quadrature.get_points(),
                                time,
                                mixture);
-      const double floor_factor =
-        schur_floor_factor(std::pow(cell->measure(), 1.0 / dim), box_size);
-      using DragAveraging = typename FluidParameters<dim>::DragAveraging;
+      const double h            = std::pow(cell->measure(), 1.0 / dim);
+      const double floor_factor = schur_floor_factor(h, box_size);
+      using DragAveraging       = typename FluidParameters<dim>::DragAveraging;
       if (parameters.drag_averaging == DragAveraging::cell ||
           (parameters.drag_averaging == DragAveraging::jump &&
-           drag_jumps_in_cell(mixture,
-                              std::pow(cell->measure(), 1.0 / dim),
-                              mu,
-                              parameters.drag_jump_contrast)))
+           drag_jumps_in_cell(mixture, h, mu, parameters.drag_jump_contrast)))
       {
         average_drag_over_cell(fe_values, mixture);
         ++averaged_cells;
@@ -309,7 +303,7 @@ namespace ImmersedGrains
           // The Schur complement approximation (block_preconditioner.h)
           // needs the pressure mass matrix weighted by phi/mu and the
           // diagonal of the mass-and-drag part c M of A,
-          // c = phi rho a0/dt + beta.
+          // c = phi rho a0/dt + beta, plus its floor (schur_floor_factor).
           const double mass_weight = phi / mu;
           max_beta                 = std::max(max_beta, beta);
           for (unsigned int i = 0; i < dofs_per_cell; ++i)
@@ -323,12 +317,11 @@ namespace ImmersedGrains
                   cell_mass(i, j) += mass_weight * phi_p[i] * phi_p[j] * JxW;
             }
             else
-            {
               cell_reaction(i) +=
-                (mass + beta) * phi_u[i][component] * phi_u[i][component] * JxW;
-              cell_floor(i) += floor_factor * phi * mu *
-                               grad_phi_u[i][component].norm_square() * JxW;
-            }
+                ((mass + beta) * phi_u[i][component] * phi_u[i][component] +
+                 floor_factor * phi * mu *
+                   grad_phi_u[i][component].norm_square()) *
+                JxW;
           }
         }
       }
@@ -432,9 +425,6 @@ namespace ImmersedGrains
       {
         pressure_mass_constraints.distribute_local_to_global(
           cell_mass, dof_indices, pressure_mass_matrix);
-        update_constraints.distribute_local_to_global(cell_floor,
-                                                      dof_indices,
-                                                      schur_floor_diagonal);
         update_constraints.distribute_local_to_global(cell_reaction,
                                                       dof_indices,
                                                       reaction_diagonal);
@@ -449,7 +439,6 @@ namespace ImmersedGrains
     {
       pressure_mass_matrix.compress(dealii::VectorOperation::add);
       reaction_diagonal.compress(dealii::VectorOperation::add);
-      schur_floor_diagonal.compress(dealii::VectorOperation::add);
       schur_has_drag =
         dealii::Utilities::MPI::max(max_beta, mpi_communicator) > 0;
     }

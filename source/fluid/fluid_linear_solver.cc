@@ -40,21 +40,19 @@ namespace ImmersedGrains
       // dominated by its mass and drag part c M, whatever the jumps in c
       // (= phi rho a0/dt + beta); a Darcy-like operator on the pressure.
       // Where c vanishes (viscous regions of a steady problem) the term
-      // must vanish from S~^{-1}: a floor on c (assembled with A, see
-      // schur_floor_factor in fluid_assembly.cc) keeps the inverse finite
-      // while making S_c large there. Rows without one (constrained
-      // velocities, whose B^T rows are empty) keep a hundredth of A's
-      // diagonal.
+      // must vanish from S~^{-1}: a floor on c, assembled into
+      // reaction_diagonal (schur_floor_factor in fluid_assembly.cc), keeps
+      // the inverse finite while making S_c large there. Constrained
+      // velocities (empty B^T rows) have none and keep a hundredth of A's
+      // diagonal, only so that the inverse exists.
       const auto                           &A = system_matrix.block(0, 0);
       dealii::TrilinosWrappers::MPI::Vector inverse_diagonal(
         owned_partitioning[0], mpi_communicator);
       for (const auto i : owned_partitioning[0])
       {
-        const double reaction = reaction_diagonal.block(0)[i];
-        const double floor    = schur_floor_diagonal.block(0)[i];
+        const double c = reaction_diagonal.block(0)[i];
         inverse_diagonal[i] =
-          1.0 /
-          (reaction + (floor > 0 ? floor : 1e-2 * std::abs(A.diag_element(i))));
+          1.0 / (c > 0 ? c : 1e-2 * std::abs(A.diag_element(i)));
       }
       inverse_diagonal.compress(dealii::VectorOperation::insert);
       dealii::TrilinosWrappers::SparseMatrix product;

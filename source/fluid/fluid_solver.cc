@@ -307,7 +307,6 @@ namespace ImmersedGrains
     old_old_solution.reinit(solution);
     system_rhs.reinit(owned_partitioning, mpi_communicator);
     reaction_diagonal.reinit(owned_partitioning, mpi_communicator);
-    schur_floor_diagonal.reinit(owned_partitioning, mpi_communicator);
     newton_update.reinit(owned_partitioning, mpi_communicator);
     preconditioner.reset();
     schur_diagonal_matrix.clear();

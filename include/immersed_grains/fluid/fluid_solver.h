@@ -184,12 +184,10 @@ namespace ImmersedGrains
 
     MatrixType system_matrix;
     MatrixType pressure_mass_matrix; // block (1,1) used
-    // Diagonal of the mass-and-drag part of the velocity block, and the
-    // Schur complement approximation B diag^{-1} B^T built from it.
-    VectorType reaction_diagonal; // block 0 used
-    // The floor on c where it vanishes: the viscous diagonal times
-    // schur_floor_factor(h) (fluid_assembly.cc); block 0 used.
-    VectorType                             schur_floor_diagonal;
+    // Diagonal of the mass-and-drag part of the velocity block plus its
+    // floor where that vanishes (schur_floor_factor, fluid_assembly.cc),
+    // and the Schur complement approximation B diag^{-1} B^T built from it.
+    VectorType                             reaction_diagonal; // block 0 used
     dealii::TrilinosWrappers::SparseMatrix schur_diagonal_matrix;
 
     VectorType solution;         // ghosted, current iterate / new time
