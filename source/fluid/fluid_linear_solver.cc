@@ -21,9 +21,10 @@ namespace ImmersedGrains
     dealii::TimerOutput::Scope scope(timer, "fluid: preconditioner");
 
     BlockSchurPreconditioner::Settings settings;
-    settings.velocity_cycles  = parameters.velocity_amg_cycles;
-    settings.inner_iterations = parameters.velocity_inner_iterations;
-    settings.inner_tolerance  = parameters.velocity_inner_tolerance;
+    settings.velocity_cycles          = parameters.velocity_amg_cycles;
+    settings.inner_iterations         = parameters.velocity_inner_iterations;
+    settings.inner_tolerance          = parameters.velocity_inner_tolerance;
+    settings.pressure_mass_iterations = parameters.pressure_mass_iterations;
     const dealii::FEValuesExtractors::Vector velocities(0);
     dealii::DoFTools::extract_constant_modes(dof_handler,
                                              fe.component_mask(velocities),

@@ -167,6 +167,16 @@ namespace ImmersedGrains
                           Double(0, 1),
                           "Relative residual at which the inner iterations "
                           "stop before Velocity inner iterations.");
+        prm.declare_entry(
+          "Pressure mass iterations",
+          "3",
+          Integer(1, 100),
+          "Applications of the inverse of the phi/mu-weighted pressure mass "
+          "matrix in the Schur complement approximation: 1 is one ILU; N > 1 "
+          "is N conjugate-gradient iterations preconditioned by it. On "
+          "several ranks the ILU is block-Jacobi, and a single one cost up "
+          "to 50% more outer iterations than on one rank "
+          "(doc/benchmarks.md).");
       }
       prm.leave_subsection();
 
@@ -233,6 +243,7 @@ namespace ImmersedGrains
         velocity_inner_iterations =
           prm.get_integer("Velocity inner iterations");
         velocity_inner_tolerance = prm.get_double("Velocity inner tolerance");
+        pressure_mass_iterations = prm.get_integer("Pressure mass iterations");
         where.require(velocity_inner_tolerance < 1,
                       "Linear solver/Velocity inner tolerance",
                       prm.get("Velocity inner tolerance"),

@@ -39,6 +39,10 @@ namespace ImmersedGrains
       unsigned int inner_iterations = 0;
       double       inner_tolerance  = 1e-6;
 
+      // 1: M_w^{-1} is one ILU application; N > 1: N CG iterations
+      // preconditioned by the ILU.
+      unsigned int pressure_mass_iterations = 3;
+
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
     };
@@ -62,8 +66,13 @@ namespace ImmersedGrains
     solve_velocity(dealii::TrilinosWrappers::MPI::Vector       &dst,
                    const dealii::TrilinosWrappers::MPI::Vector &src) const;
 
+    void
+    solve_pressure_mass(dealii::TrilinosWrappers::MPI::Vector       &dst,
+                        const dealii::TrilinosWrappers::MPI::Vector &src) const;
+
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
     const Settings                                     settings;
+    const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass;
 
     dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;

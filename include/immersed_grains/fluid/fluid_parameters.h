@@ -65,6 +65,7 @@ namespace ImmersedGrains
     unsigned int velocity_amg_cycles       = 2;
     unsigned int velocity_inner_iterations = 0;
     double       velocity_inner_tolerance  = 1e-6;
+    unsigned int pressure_mass_iterations  = 3;
 
     // Prescribed fields; shared so that a test can substitute exact ones.
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> fluid_fraction;
