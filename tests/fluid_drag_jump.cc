@@ -11,6 +11,13 @@
 // drag averaged: every cell with 'cell'; with 'jump' exactly the cells that
 // the circle cuts (those whose quadrature points lie on both sides: 36 and
 // 68, counted independently from the 3 x 3 Gauss points).
+//
+// Last, the same ball without drag, steady, at levels 5 and 6, must
+// converge within 24 iterations on one rank and on two: the Schur
+// complement approximation is then the pressure mass matrix alone, and its
+// inverse must not depend on the partition (measured 18-21 on one rank and
+// on two; with a single block-Jacobi ILU two ranks needed 28 and 32,
+// doc/benchmarks.md, sixth round).
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/distributed/tria.h>
@@ -22,6 +29,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 
 using namespace dealii;
 using namespace ImmersedGrains;
@@ -59,6 +67,59 @@ public:
   }
 };
 
+// Solves one step of the ball problem; returns whether FGMRES converged
+// within @p max_iterations, and the number of cells whose drag was
+// averaged.
+std::pair<bool, unsigned int>
+solve_ball(const std::string &averaging_entry,
+           const unsigned int level,
+           const double       dt,
+           const double       beta_scaled,
+           const unsigned int max_iterations,
+           unsigned int      &n_cells)
+{
+  ParameterHandler prm;
+  Simulation<2>::declare_parameters(prm);
+  prm.parse_input_from_string(
+    std::string("subsection Fluid\n set Density = 1000\n"
+                " set Viscosity = 1\n set Advection = false\n") +
+    averaging_entry + " set Time scheme = BDF1\n set Time derivative = " +
+    (dt > 0 ? "true" : "false") +
+    "\n subsection Linear solver\n  set Max iterations = " +
+    std::to_string(max_iterations) + "\n end\nend\n");
+  Geometry<2> geometry;
+  geometry.parse_parameters(prm, "drag_jump");
+  geometry.initial_refinement = level;
+  FluidParameters<2> parameters;
+  parameters.parse_parameters(prm, "drag_jump", geometry);
+
+  const double       h    = 1.0 / (1 << level);
+  const double       beta = beta_scaled * parameters.viscosity / (h * h);
+  ConditionalOStream pcout(std::cout, false);
+  TimerOutput        timer(pcout, TimerOutput::never, TimerOutput::wall_times);
+  parallel::distributed::Triangulation<2> tria(MPI_COMM_WORLD);
+  geometry.create_mesh(tria);
+  FluidSolver<2> fluid(parameters, geometry, tria, timer, pcout);
+  fluid.set_mixture_fields(std::make_shared<PrescribedMixtureFields<2>>(
+    std::make_shared<Ball>(0.35, 1.0),
+    std::make_shared<Ball>(beta, 0.0),
+    std::make_shared<Functions::ZeroFunction<2>>(2)));
+  fluid.set_forcing(std::make_shared<Swirl>());
+  fluid.setup_dofs();
+  fluid.set_initial_condition();
+  n_cells = tria.n_global_active_cells();
+  try
+  {
+    return {true,
+            fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0)
+              .drag_averaged_cells};
+  }
+  catch (const std::exception &)
+  {
+    return {false, 0};
+  }
+}
+
 int
 main(int argc, char **argv)
 {
@@ -73,47 +134,9 @@ main(int argc, char **argv)
           averaging == "jump" ?
             "" :
             " set Drag coefficient averaging = " + averaging + "\n";
-        ParameterHandler prm;
-        Simulation<2>::declare_parameters(prm);
-        prm.parse_input_from_string(
-          std::string("subsection Fluid\n set Density = 1000\n"
-                      " set Viscosity = 1\n set Advection = false\n") +
-          averaging_entry + " set Time scheme = BDF1\n set Time derivative = " +
-          (dt > 0 ? "true" : "false") +
-          "\n subsection Linear solver\n  set Max iterations = 30\n "
-          "end\nend\n");
-        Geometry<2> geometry;
-        geometry.parse_parameters(prm, "drag_jump");
-        geometry.initial_refinement = level;
-        FluidParameters<2> parameters;
-        parameters.parse_parameters(prm, "drag_jump", geometry);
-
-        const double       h    = 1.0 / (1 << level);
-        const double       beta = 1e8 * parameters.viscosity / (h * h);
-        ConditionalOStream pcout(std::cout, false);
-        TimerOutput timer(pcout, TimerOutput::never, TimerOutput::wall_times);
-        parallel::distributed::Triangulation<2> tria(MPI_COMM_WORLD);
-        geometry.create_mesh(tria);
-        FluidSolver<2> fluid(parameters, geometry, tria, timer, pcout);
-        fluid.set_mixture_fields(std::make_shared<PrescribedMixtureFields<2>>(
-          std::make_shared<Ball>(0.35, 1.0),
-          std::make_shared<Ball>(beta, 0.0),
-          std::make_shared<Functions::ZeroFunction<2>>(2)));
-        fluid.set_forcing(std::make_shared<Swirl>());
-        fluid.setup_dofs();
-        fluid.set_initial_condition();
-        bool         converged      = true;
-        unsigned int averaged_cells = 0;
-        try
-        {
-          averaged_cells =
-            fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0)
-              .drag_averaged_cells;
-        }
-        catch (const std::exception &)
-        {
-          converged = false;
-        }
+        unsigned int n_cells = 0;
+        const auto [converged, averaged_cells] =
+          solve_ball(averaging_entry, level, dt, 1e8, 30, n_cells);
         if (root)
           std::printf("%s averaging, level %u, %s, beta h^2/mu = 1e8: %s, "
                       "drag averaged in %u of %u cells\n",
@@ -123,6 +146,16 @@ main(int argc, char **argv)
                       converged ? "converged within 30 iterations" :
                                   "NOT converged within 30 iterations",
                       averaged_cells,
-                      tria.n_global_active_cells());
+                      n_cells);
       }
+  for (const unsigned int level : {5u, 6u})
+  {
+    unsigned int n_cells   = 0;
+    const bool   converged = solve_ball("", level, 0.0, 0.0, 24, n_cells).first;
+    if (root)
+      std::printf("no drag, level %u, steady: %s\n",
+                  level,
+                  converged ? "converged within 24 iterations" :
+                              "NOT converged within 24 iterations");
+  }
 }
