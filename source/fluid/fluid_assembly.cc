@@ -57,7 +57,7 @@ namespace ImmersedGrains
     // coarse meshes, where the ball is a few cells across, much larger
     // floors are better (h = L/8, steady, largest drag: 2D 20 -> 12 and
     // 3D 33 -> 16 iterations with 0.3 instead of 10^-2; a packed bed on
-    // such a mesh 46-49 -> 38-42). Hence 10^-2 at h = L/16, falling like
+    // such a mesh 46-51 -> 38-43). Hence 10^-2 at h = L/16, falling like
     // h^2 to 10^-3 below, rising like h^5 to 0.3 above.
     double
     schur_floor_factor(const double h, const double L)

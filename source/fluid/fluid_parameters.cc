@@ -171,9 +171,9 @@ namespace ImmersedGrains
           "Pressure mass iterations",
           "3",
           Integer(1, 100),
-          "Applications of the inverse of the phi/mu-weighted pressure mass "
-          "matrix in the Schur complement approximation: 1 is one ILU; N > 1 "
-          "is N conjugate-gradient iterations preconditioned by it. On "
+          "How the inverse of the phi/mu-weighted pressure mass matrix in the "
+          "Schur complement approximation is applied: 1 is one ILU; N > 1 is "
+          "N conjugate-gradient iterations preconditioned by that ILU. On "
           "several ranks the ILU is block-Jacobi, and a single one cost up "
           "to 50% more outer iterations than on one rank "
           "(doc/benchmarks.md).");

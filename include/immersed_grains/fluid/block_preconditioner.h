@@ -20,9 +20,10 @@ namespace ImmersedGrains
    * preconditioned by them (a variable preconditioner: FGMRES outside). S~^{-1}
    * is the Cahouet-Chabard sum M_w^{-1} + S_c^{-1} of a pressure mass matrix
    * weighted by phi/mu (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T,
-   * the limit where mass and drag c = phi rho a0/dt + beta dominate, each
-   * approximated by one application of ILU (mass) or AMG (S_c); either term may
-   * be left out. doc/theory.md motivates the choice.
+   * the limit where mass and drag c = phi rho a0/dt + beta dominate, the
+   * first approximated by a few ILU-preconditioned CG iterations, the second
+   * by one AMG V-cycle; either term may be left out. doc/theory.md motivates
+   * the choice.
    */
   class BlockSchurPreconditioner
   {
