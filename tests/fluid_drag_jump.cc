@@ -29,7 +29,6 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <utility>
 
 using namespace dealii;
 using namespace ImmersedGrains;
@@ -67,16 +66,20 @@ public:
   }
 };
 
-// Solves one step of the ball problem; returns whether FGMRES converged
-// within @p max_iterations, and the number of cells whose drag was
-// averaged.
-std::pair<bool, unsigned int>
+struct BallResult
+{
+  bool         converged;      // within the given number of iterations
+  unsigned int averaged_cells; // cells whose drag was averaged
+  unsigned int n_cells;
+};
+
+// Solves one step of the ball problem.
+BallResult
 solve_ball(const std::string &averaging_entry,
            const unsigned int level,
            const double       dt,
            const double       beta_scaled,
-           const unsigned int max_iterations,
-           unsigned int      &n_cells)
+           const unsigned int max_iterations)
 {
   ParameterHandler prm;
   Simulation<2>::declare_parameters(prm);
@@ -107,16 +110,17 @@ solve_ball(const std::string &averaging_entry,
   fluid.set_forcing(std::make_shared<Swirl>());
   fluid.setup_dofs();
   fluid.set_initial_condition();
-  n_cells = tria.n_global_active_cells();
+  const unsigned int n_cells = tria.n_global_active_cells();
   try
   {
     return {true,
             fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0)
-              .drag_averaged_cells};
+              .drag_averaged_cells,
+            n_cells};
   }
   catch (const std::exception &)
   {
-    return {false, 0};
+    return {false, 0, n_cells};
   }
 }
 
@@ -134,24 +138,22 @@ main(int argc, char **argv)
           averaging == "jump" ?
             "" :
             " set Drag coefficient averaging = " + averaging + "\n";
-        unsigned int n_cells = 0;
-        const auto [converged, averaged_cells] =
-          solve_ball(averaging_entry, level, dt, 1e8, 30, n_cells);
+        const BallResult result =
+          solve_ball(averaging_entry, level, dt, 1e8, 30);
         if (root)
           std::printf("%s averaging, level %u, %s, beta h^2/mu = 1e8: %s, "
                       "drag averaged in %u of %u cells\n",
                       averaging.c_str(),
                       level,
                       dt > 0 ? "dt = 1" : "steady",
-                      converged ? "converged within 30 iterations" :
-                                  "NOT converged within 30 iterations",
-                      averaged_cells,
-                      n_cells);
+                      result.converged ? "converged within 30 iterations" :
+                                         "NOT converged within 30 iterations",
+                      result.averaged_cells,
+                      result.n_cells);
       }
   for (const unsigned int level : {5u, 6u})
   {
-    unsigned int n_cells   = 0;
-    const bool   converged = solve_ball("", level, 0.0, 0.0, 24, n_cells).first;
+    const bool converged = solve_ball("", level, 0.0, 0.0, 24).converged;
     if (root)
       std::printf("no drag, level %u, steady: %s\n",
                   level,
