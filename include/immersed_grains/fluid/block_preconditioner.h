@@ -44,6 +44,9 @@ namespace ImmersedGrains
       // preconditioned by the ILU.
       unsigned int pressure_mass_iterations = 3;
 
+      // The weight of M_w^{-1} in the sum (1: Cahouet-Chabard's).
+      double pressure_mass_weight = 1.0;
+
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
     };
