@@ -22,8 +22,9 @@ namespace ImmersedGrains
    * weighted by phi/mu (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T,
    * the limit where mass and drag c = phi rho a0/dt + beta dominate, the
    * first approximated by a few ILU-preconditioned CG iterations, the second
-   * by one AMG V-cycle; either term may be left out. doc/theory.md motivates
-   * the choice.
+   * by one AMG V-cycle; either term may be left out, and the first may be
+   * weighted (Settings::pressure_mass_weight). doc/theory.md motivates the
+   * choice.
    */
   class BlockSchurPreconditioner
   {
