@@ -156,8 +156,8 @@ main(int argc, char **argv)
       }
   // The finest level, steady, where the Stokes-Darcy interface is hardest
   // for the Schur complement approximation: within the 30 (measured
-  // 28-29 on one rank and on two; 33 before the pressure mass matrix's
-  // weight of 2 in 2D steady problems, doc/benchmarks.md, seventh round).
+  // 23-24 on one rank and on two; 33 before the pressure mass matrix was
+  // lightened in the drag cells, doc/benchmarks.md, seventh round).
   for (const double beta_scaled : {1e4, 1e8})
   {
     const bool converged = solve_ball("", 7, 0.0, beta_scaled, 30).converged;

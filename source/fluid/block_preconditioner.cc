@@ -65,11 +65,7 @@ namespace ImmersedGrains
     // Pressure: -S~^{-1} g.
     dst.block(1) = 0;
     if (use_mass)
-    {
       solve_pressure_mass(dst.block(1), src.block(1));
-      if (settings.pressure_mass_weight != 1.0)
-        dst.block(1) *= settings.pressure_mass_weight;
-    }
     if (use_laplace)
     {
       pressure_laplace_amg.vmult(pressure_tmp, src.block(1));

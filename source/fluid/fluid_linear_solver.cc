@@ -35,18 +35,6 @@ namespace ImmersedGrains
     const bool laplace_term =
       parameters.schur_approximation != SchurApproximation::pressure_mass &&
       (parameters.time_derivative || schur_has_drag);
-    // In 2D steady problems with drag, M_w^{-1} counts twice in the sum. The
-    // sum is exact for constant coefficients on a periodic domain; at a
-    // Stokes-Darcy interface it is not, and there the viscous term weighed
-    // too little against the Darcy term S_c^{-1}: the drag-jump benchmark's
-    // steady cells with drag took 33 iterations at 2D level 7 with weight 1
-    // and 28-29 with 2, on one rank and on two (1.5: 28-30, 3: 28-32;
-    // doc/benchmarks.md, seventh round). Not in 3D, where 2 changed the
-    // counts by -1 to +2, nor with a time derivative, where it cost up to 5
-    // more (2D level 7, dt = 1: 25 -> 29 without drag); nor without drag,
-    // where S~ is M_w alone and a weight only rescales it.
-    if (dim == 2 && !parameters.time_derivative && mass_term && laplace_term)
-      settings.pressure_mass_weight = 2.0;
     if (laplace_term)
     {
       // S_c = B diag(c M)^{-1} B^T: the Schur complement where A is

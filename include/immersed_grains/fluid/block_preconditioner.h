@@ -22,9 +22,9 @@ namespace ImmersedGrains
    * weighted by phi/mu (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T,
    * the limit where mass and drag c = phi rho a0/dt + beta dominate, the
    * first approximated by a few ILU-preconditioned CG iterations, the second
-   * by one AMG V-cycle; either term may be left out, and the first may be
-   * weighted (Settings::pressure_mass_weight). doc/theory.md motivates the
-   * choice.
+   * by one AMG V-cycle; either term may be left out. M_w's weight is
+   * reduced where drag dominates (fluid_assembly.cc). doc/theory.md
+   * motivates the choice.
    */
   class BlockSchurPreconditioner
   {
@@ -44,9 +44,6 @@ namespace ImmersedGrains
       // 1: M_w^{-1} is one ILU application; N > 1: N CG iterations
       // preconditioned by the ILU.
       unsigned int pressure_mass_iterations = 3;
-
-      // The weight of M_w^{-1} in the sum (1: Cahouet-Chabard's).
-      double pressure_mass_weight = 1.0;
 
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
