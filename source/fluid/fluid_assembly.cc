@@ -78,8 +78,8 @@ namespace ImmersedGrains
     // 3D level 4: 30 / 33 -> 22 / 22 iterations, 2D level 7: 33 / 33 -> 24 /
     // 23; dt = 1, 2D level 7: 22 -> 15 (doc/benchmarks.md, seventh round). The
     // factor falls smoothly from 1 below r = 100 to 0.03, where it stops so
-    // that M_w keeps a bounded contrast for its ILU (0.01 and 0.1 measured
-    // the same).
+    // that M_w keeps a bounded contrast for its ILU (0.01 and 0.1 as the
+    // bound: 23 / 21 and 21 / 24 at 3D level 4).
     double
     drag_cell_mass_factor(const double r)
     {
