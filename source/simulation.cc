@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 namespace ImmersedGrains
 {
@@ -68,6 +69,37 @@ namespace ImmersedGrains
       c.emplace_back("drag_averaged_cells");
       return c;
     }
+
+    // The timings.csv columns and the TimerOutput sections each one sums.
+    const std::vector<std::pair<std::string, std::vector<std::string>>> &
+    timing_phases()
+    {
+      static const std::vector<std::pair<std::string, std::vector<std::string>>>
+        phases = {{"setup", {"mesh", "fluid: setup", "grains: setup"}},
+                  {"assembly", {"fluid: assembly"}},
+                  {"preconditioner", {"fluid: preconditioner"}},
+                  {"solve", {"fluid: solve", "fluid: direct solve"}},
+                  {"solid_fraction", {"coupling: solid fraction"}},
+                  {"interaction_force", {"coupling: interaction force"}},
+                  {"grain_velocities",
+                   {"grains: free velocities", "grains: gather"}},
+                  {"contacts", {"grains: contacts"}},
+                  {"sort", {"grains: move and sort"}},
+                  {"output", {"output"}},
+                  {"statistics", {"statistics"}}};
+      return phases;
+    }
+
+    std::vector<std::string>
+    timing_columns()
+    {
+      std::vector<std::string> c = {"step", "time"};
+      for (const auto &phase : timing_phases())
+        c.push_back(phase.first);
+      c.emplace_back("other");
+      c.emplace_back("total");
+      return c;
+    }
   } // namespace
 
 
@@ -91,14 +123,27 @@ namespace ImmersedGrains
                       "0.01",
                       Double(0),
                       "Time step [s]; with Adaptive time step, the largest.");
-    prm.declare_entry("Adaptive time step",
-                      "false",
-                      Bool(),
-                      "Shorten the step so that no grain moves more than "
-                      "Grains/Max displacement fraction of the smallest "
-                      "radius in one step, nor more than half the shortest "
-                      "cell edge (so that the particle search, under MPI "
-                      "the ghost layer, can follow it).");
+    prm.declare_entry(
+      "Adaptive time step",
+      "false",
+      Bool(),
+      "Shorten the step to follow the motion. With grains coupled to a "
+      "fluid and Coupling/Grain sub-steps on: the fluid step is set by the "
+      "flow, at most Courant number times the shortest cell edge over the "
+      "largest grain speed (the solid fraction moves by at most that part "
+      "of a cell per fluid step) and, with advection, over the largest "
+      "fluid speed; the grains sub-step inside it so that none moves more "
+      "than Grains/Max displacement fraction of the smallest radius per "
+      "sub-step. Otherwise the whole step follows the grains: no grain "
+      "moves more than that fraction of the smallest radius, nor more than "
+      "half the shortest cell edge, in one step.");
+    prm.declare_entry(
+      "Courant number",
+      "0.25",
+      Double(0),
+      "With Adaptive time step: the largest fraction of the shortest cell "
+      "edge that grains (and, with advection, the fluid) cross in one fluid "
+      "step (doc/performance.md measures the error against cost).");
 
     prm.enter_subsection("Output");
     {
@@ -153,11 +198,13 @@ namespace ImmersedGrains
       , parameter_file(file)
       , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       , statistics(statistics_columns(dim))
+      , timings(timing_columns())
       , triangulation(comm,
                       typename dealii::Triangulation<dim>::MeshSmoothing(
                         dealii::Triangulation<dim>::smoothing_on_refinement |
                         dealii::Triangulation<dim>::smoothing_on_coarsening))
       , wall_start(now())
+      , last_timing_wall(wall_start)
   {
     const InputLocation top{file, ""};
     output_directory = prm.get("Output directory");
@@ -171,6 +218,11 @@ namespace ImmersedGrains
                 prm.get("Time step"),
                 "must be positive");
     adaptive_time_step = prm.get_bool("Adaptive time step");
+    courant_number     = prm.get_double("Courant number");
+    top.require(courant_number > 0 || !adaptive_time_step,
+                "Courant number",
+                prm.get("Courant number"),
+                "must be positive with Adaptive time step");
 
     prm.enter_subsection("Output");
     {
@@ -248,6 +300,7 @@ namespace ImmersedGrains
     MPI_Barrier(comm);
     log.open(output_directory + "/log.txt", root, !quiet);
     statistics.open(output_directory + "/statistics.csv", root);
+    timings.open(output_directory + "/timings.csv", root);
     field_output = std::make_unique<FieldOutput<dim>>(output_directory, comm);
     particle_output =
       std::make_unique<ParticleOutput<dim>>(output_directory, comm);
@@ -261,6 +314,13 @@ namespace ImmersedGrains
     {
       dealii::TimerOutput::Scope scope(*timer, "mesh");
       geometry.create_mesh(triangulation);
+    }
+    {
+      double h = std::numeric_limits<double>::max();
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (cell->is_locally_owned())
+          h = std::min(h, cell->minimum_vertex_distance());
+      shortest_cell_edge = dealii::Utilities::MPI::min(h, comm);
     }
     pcout << "immersed-grains: " << dim << "D scene " << parameter_file
           << " on " << dealii::Utilities::MPI::n_mpi_processes(comm)
@@ -341,6 +401,7 @@ namespace ImmersedGrains
     setup();
     postprocess(0, 0);
     maybe_write_fields(true);
+    record_timings();
 
     // Steps end exactly on End time; a last short step is allowed.
     try
@@ -351,6 +412,7 @@ namespace ImmersedGrains
         ++step;
         solve_time_step(dt);
         maybe_write_fields(time >= end_time * (1 - 1e-12));
+        record_timings();
       }
     }
     catch (...)
@@ -376,8 +438,26 @@ namespace ImmersedGrains
   Simulation<dim>::next_time_step() const
   {
     double dt = time_step;
-    if (adaptive_time_step && grains)
-      dt = grains->stable_time_step(dt);
+    if (adaptive_time_step)
+    {
+      if (coupling && coupling_parameters.grain_substeps)
+      {
+        // Multi-rate: the fluid follows the flow, the grains sub-step
+        // inside (solve_coupled_time_step).
+        const double h = grains->shortest_cell_edge();
+        const double v = grains->max_speed();
+        if (v > 0)
+          dt = std::min(dt, courant_number * h / v);
+      }
+      else if (grains)
+        dt = grains->stable_time_step(dt);
+      if (fluid && fluid_parameters.advection)
+      {
+        const double u = fluid->max_velocity();
+        if (u > 0)
+          dt = std::min(dt, courant_number * shortest_cell_edge / u);
+      }
+    }
     return std::min(dt, end_time - time);
   }
 
@@ -591,6 +671,45 @@ namespace ImmersedGrains
     statistics.set("kinetic_energy", s.kinetic_energy);
     statistics.set("packing_fraction", s.packing_fraction);
     statistics.set("grains_removed", grains->n_removed());
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::record_timings()
+  {
+    // Wall seconds spent in each phase since the last row, the slowest
+    // rank's (a step waits for it).
+    const auto totals =
+      timer->get_summary_data(dealii::TimerOutput::total_wall_time);
+    std::vector<double> spent;
+    for (const auto &[column, sections] : timing_phases())
+    {
+      double sum = 0;
+      for (const auto &section : sections)
+        if (const auto it = totals.find(section); it != totals.end())
+          sum += it->second;
+      spent.push_back(sum - timer_totals[column]);
+      timer_totals[column] = sum;
+    }
+    const double wall = now();
+    spent.push_back(wall - last_timing_wall);
+    last_timing_wall = wall;
+    dealii::Utilities::MPI::max(dealii::ArrayView<const double>(spent),
+                                comm,
+                                dealii::ArrayView<double>(spent));
+
+    timings.set("step", step);
+    timings.set("time", time);
+    double phases = 0;
+    for (unsigned int i = 0; i < timing_phases().size(); ++i)
+    {
+      timings.set(timing_phases()[i].first, spent[i]);
+      phases += spent[i];
+    }
+    timings.set("total", spent.back());
+    timings.set("other", std::max(0.0, spent.back() - phases));
+    timings.write_row();
   }
 
 

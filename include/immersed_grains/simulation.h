@@ -15,6 +15,7 @@
 #include <immersed_grains/io/test_checks.h>
 #include <immersed_grains/mesh/geometry.h>
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -72,6 +73,9 @@ namespace ImmersedGrains
     maybe_write_fields(bool force);
     void
     print_test_row(bool last) const;
+    // One row of timings.csv: the wall time of each phase since the last.
+    void
+    record_timings();
 
     MPI_Comm    comm;
     std::string parameter_file;
@@ -79,6 +83,8 @@ namespace ImmersedGrains
     double      end_time           = 1;
     double      time_step          = 1;
     bool        adaptive_time_step = false;
+    double      courant_number     = 0.25;
+    double      shortest_cell_edge = 0;
 
     unsigned int                    write_fields_every = 0;
     bool                            test_output        = false;
@@ -101,6 +107,7 @@ namespace ImmersedGrains
     dealii::ConditionalOStream           pcout;
     std::unique_ptr<dealii::TimerOutput> timer;
     Statistics                           statistics;
+    Statistics                           timings;
 
     dealii::parallel::distributed::Triangulation<dim> triangulation;
     std::unique_ptr<FluidSolver<dim>>                 fluid;
@@ -112,6 +119,9 @@ namespace ImmersedGrains
     double       time = 0;
     unsigned int step = 0;
     double       wall_start;
+    double       last_timing_wall;
+    // TimerOutput's totals per timings.csv column at the last row.
+    std::map<std::string, double> timer_totals;
   };
 } // namespace ImmersedGrains
 

@@ -1,6 +1,5 @@
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
-#include <deal.II/matrix_free/fe_point_evaluation.h>
 
 #include <immersed_grains/coupling/filtered_drag.h>
 
@@ -14,6 +13,7 @@ namespace ImmersedGrains
     const bool                                               drag_as_field,
     const bool                                               implicit_velocity)
       : filter(tria, geometry)
+      , shapes(filter.get_fe())
       , length(length)
       , drag_as_field(drag_as_field)
       , implicit_velocity(implicit_velocity)
@@ -253,22 +253,16 @@ namespace ImmersedGrains
     const unsigned int n    = filter.get_fe().n_dofs_per_cell();
     std::vector<dealii::types::global_dof_index> indices(n);
     cell->get_dof_indices(indices);
-    dealii::FEPointEvaluation<1, dim> evaluator(filter.get_mapping(),
-                                                filter.get_fe(),
-                                                dealii::update_values);
-    evaluator.reinit(
-      tria_cell, dealii::ArrayView<const dealii::Point<dim>>(reference_points));
+    shapes.reinit(tria_cell, reference_points, false);
     std::vector<double>                       local(n);
     std::array<std::vector<double>, n_fields> result;
     for (std::size_t f = 0; f < n_fields; ++f)
     {
       for (unsigned int i = 0; i < n; ++i)
         local[i] = (*fields[f])[indices[i]];
-      evaluator.evaluate(dealii::ArrayView<const double>(local),
-                         dealii::EvaluationFlags::values);
       result[f].resize(reference_points.size());
       for (unsigned int q = 0; q < reference_points.size(); ++q)
-        result[f][q] = evaluator.get_value(q);
+        result[f][q] = shapes.value_of(local, q);
     }
     return result;
   }

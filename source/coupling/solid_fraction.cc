@@ -2,7 +2,6 @@
 
 #include <deal.II/fe/fe_values.h>
 
-#include <deal.II/matrix_free/fe_point_evaluation.h>
 
 #include <immersed_grains/coupling/solid_fraction.h>
 
@@ -53,6 +52,7 @@ namespace ImmersedGrains
     const dealii::parallel::distributed::Triangulation<dim> &tria)
       : parameters(parameters)
       , filter(tria, geometry)
+      , shapes(filter.get_fe())
   {
   }
 
@@ -200,27 +200,21 @@ namespace ImmersedGrains
     cell->get_dof_indices(indices);
     std::vector<double> local(n);
 
-    // Values and gradients of Q1 fields at arbitrary points of the cell.
-    dealii::FEPointEvaluation<1, dim> evaluator(filter.get_mapping(),
-                                                filter.get_fe(),
-                                                dealii::update_values |
-                                                  dealii::update_gradients);
-    evaluator.reinit(
-      tria_cell, dealii::ArrayView<const dealii::Point<dim>>(reference_points));
-
+    shapes.reinit(tria_cell, reference_points, true);
+    std::vector<double> field_values(n_points);
+    // Fills local (the cell's coefficients) and field_values.
     auto evaluate_field = [&](const dealii::TrilinosWrappers::MPI::Vector &v)
     {
       for (unsigned int i = 0; i < n; ++i)
         local[i] = v[indices[i]];
-      evaluator.evaluate(dealii::ArrayView<const double>(local),
-                         dealii::EvaluationFlags::values |
-                           dealii::EvaluationFlags::gradients);
+      for (unsigned int q = 0; q < n_points; ++q)
+        field_values[q] = shapes.value_of(local, q);
     };
 
     evaluate_field(fraction);
     for (unsigned int q = 0; q < n_points; ++q)
     {
-      const double phi = 1 - evaluator.get_value(q);
+      const double phi = 1 - field_values[q];
       // Clamped where grains pack beyond the physical range: the gradient
       // of the clamped field is then zero.
       if (phi < parameters.min_fluid_fraction)
@@ -231,7 +225,7 @@ namespace ImmersedGrains
       else
       {
         values.fluid_fraction[q]          = std::min(phi, 1.0);
-        values.fluid_fraction_gradient[q] = -evaluator.get_gradient(q);
+        values.fluid_fraction_gradient[q] = -shapes.gradient_of(local, q);
       }
       values.drag_coefficient[q] = 0;
       values.mass_source[q]      = 0;
@@ -244,9 +238,9 @@ namespace ImmersedGrains
       evaluate_field(flux[d]);
       for (unsigned int q = 0; q < n_points; ++q)
       {
-        values.solid_flux[q][d] = evaluator.get_value(q);
+        values.solid_flux[q][d] = field_values[q];
         values.grain_velocity[q][d] =
-          solid[q] > 1e-12 ? evaluator.get_value(q) / solid[q] : 0.0;
+          solid[q] > 1e-12 ? field_values[q] / solid[q] : 0.0;
       }
     }
   }

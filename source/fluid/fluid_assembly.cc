@@ -128,6 +128,15 @@ namespace ImmersedGrains
    * let no grain through),
    * with div(phi v) = phi div v + grad phi . v, so that the pressure and the
    * continuity blocks are transposes of each other.
+   *
+   * Each Taylor-Hood velocity shape function has one non-zero component, a
+   * scalar Q2 function N_a times a unit vector. Every term but Newton's
+   * couples a component only with itself, with the same coefficients for
+   * each, so the velocity block is integrated once as a scalar n_s x n_s
+   * matrix K and copied onto the dim diagonal blocks; the pressure coupling
+   * B (and its transpose) as dim n_s x n_p matrices. This does about a
+   * tenth of the work of a loop over all pairs of vector-valued shape
+   * functions (doc/performance.md).
    */
   template <int dim>
   void
@@ -172,6 +181,21 @@ namespace ImmersedGrains
     const dealii::FEValuesExtractors::Vector velocities(0);
     const dealii::FEValuesExtractors::Scalar pressure(dim);
 
+    // Local index of velocity component c of scalar Q2 function a, and of
+    // pressure function b.
+    const unsigned int n_s = fe.base_element(0).n_dofs_per_cell();
+    const unsigned int n_p = fe.base_element(1).n_dofs_per_cell();
+    std::vector<std::array<unsigned int, dim>> velocity_dof(n_s);
+    std::vector<unsigned int>                  pressure_dof(n_p);
+    for (unsigned int k = 0; k < dofs_per_cell; ++k)
+    {
+      const auto [component, index] = fe.system_to_component_index(k);
+      if (component < dim)
+        velocity_dof[index][component] = k;
+      else
+        pressure_dof[index] = k;
+    }
+
     dealii::FullMatrix<double> cell_matrix(dofs_per_cell, dofs_per_cell);
     dealii::FullMatrix<double> cell_mass(dofs_per_cell, dofs_per_cell);
     dealii::Vector<double>     cell_rhs(dofs_per_cell);
@@ -184,19 +208,30 @@ namespace ImmersedGrains
     std::vector<PointDrag<dim>>                  drags;
     std::vector<double>                          point_shape(dofs_per_cell);
     std::vector<double>                          local_solution(dofs_per_cell);
+    std::vector<double> local_old(dofs_per_cell), local_older(dofs_per_cell);
 
-    std::vector<dealii::Tensor<1, dim>> u(n_q), u_old(n_q), u_older(n_q);
-    std::vector<dealii::Tensor<2, dim>> grad_u(n_q);
-    std::vector<double>                 p(n_q);
-    std::vector<dealii::Tensor<1, dim>> grad_p(n_q);
+    // Scalar shape data at one quadrature point: N_a, grad N_a by
+    // coordinate (contiguous, so the pair loops vectorise), and the same
+    // for the pressure functions.
+    std::vector<double>                  N(n_s), Np(n_p);
+    std::array<std::vector<double>, dim> G, Gp;
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      G[d].resize(n_s);
+      Gp[d].resize(n_p);
+    }
+    // Cell integrals: K (velocity block of one component), W (Newton's
+    // cross terms, dim x dim blocks), B (velocity-pressure coupling per
+    // component, also the continuity block's transpose), C (pressure
+    // mobility), Mp (weighted pressure mass), R (mass-and-drag diagonal).
+    std::vector<double> K(n_s * n_s), B(dim * n_s * n_p), C(n_p * n_p),
+      Mp(n_p * n_p), R(n_s), advection_weight(n_s);
+    std::vector<double> W(parameters.newton ? dim * dim * n_s * n_s : 0);
+    std::vector<dealii::Tensor<1, dim>> rhs_u(n_s);
+    std::vector<double>                 rhs_p(n_p);
+
     std::vector<dealii::Vector<double>> f(n_q, dealii::Vector<double>(dim));
     MixtureValues<dim>                  mixture;
-
-    std::vector<dealii::Tensor<1, dim>> phi_u(dofs_per_cell);
-    std::vector<dealii::Tensor<2, dim>> grad_phi_u(dofs_per_cell);
-    std::vector<double>                 div_phi_u(dofs_per_cell);
-    std::vector<double>                 phi_p(dofs_per_cell);
-    std::vector<dealii::Tensor<1, dim>> grad_phi_p(dofs_per_cell);
 
     const double rho = parameters.density, mu = parameters.viscosity;
     const double inv_dt =
@@ -214,18 +249,25 @@ namespace ImmersedGrains
       if (!cell->is_locally_owned())
         continue;
       fe_values.reinit(cell);
-      if (point_drag_source)
-      {
-        cell->get_dof_indices(dof_indices);
+      cell->get_dof_indices(dof_indices);
+      for (unsigned int k = 0; k < dofs_per_cell; ++k)
+        local_solution[k] = solution(dof_indices[k]);
+      if (inv_dt > 0)
         for (unsigned int k = 0; k < dofs_per_cell; ++k)
-          local_solution[k] = solution(dof_indices[k]);
-      }
-      cell_matrix = 0;
-      cell_rhs    = 0;
+        {
+          local_old[k]   = old_solution(dof_indices[k]);
+          local_older[k] = old_old_solution(dof_indices[k]);
+        }
+      std::fill(K.begin(), K.end(), 0.0);
+      std::fill(B.begin(), B.end(), 0.0);
+      std::fill(C.begin(), C.end(), 0.0);
+      std::fill(W.begin(), W.end(), 0.0);
+      std::fill(rhs_u.begin(), rhs_u.end(), dealii::Tensor<1, dim>());
+      std::fill(rhs_p.begin(), rhs_p.end(), 0.0);
       if (assemble_preconditioner_matrices)
       {
-        cell_mass     = 0;
-        cell_reaction = 0;
+        std::fill(Mp.begin(), Mp.end(), 0.0);
+        std::fill(R.begin(), R.end(), 0.0);
       }
       // Integrals of the drag coefficient field and of the viscosity phi mu
       // over the cell, for drag_cell_mass_factor. Not the grains' point or
@@ -250,19 +292,51 @@ namespace ImmersedGrains
         average_drag_over_cell(fe_values, mixture);
         ++averaged_cells;
       }
-      fe_values[velocities].get_function_values(solution, u);
-      fe_values[velocities].get_function_gradients(solution, grad_u);
-      fe_values[pressure].get_function_values(solution, p);
-      fe_values[pressure].get_function_gradients(solution, grad_p);
-      if (inv_dt > 0)
-      {
-        fe_values[velocities].get_function_values(old_solution, u_old);
-        fe_values[velocities].get_function_values(old_old_solution, u_older);
-      }
       forcing->vector_value_list(fe_values.get_quadrature_points(), f);
 
       for (unsigned int q = 0; q < n_q; ++q)
       {
+        for (unsigned int a = 0; a < n_s; ++a)
+        {
+          const unsigned int k = velocity_dof[a][0];
+          N[a]                 = fe_values.shape_value(k, q);
+          const auto grad      = fe_values.shape_grad(k, q);
+          for (unsigned int d = 0; d < dim; ++d)
+            G[d][a] = grad[d];
+        }
+        for (unsigned int b = 0; b < n_p; ++b)
+        {
+          const unsigned int k = pressure_dof[b];
+          Np[b]                = fe_values.shape_value(k, q);
+          const auto grad      = fe_values.shape_grad(k, q);
+          for (unsigned int d = 0; d < dim; ++d)
+            Gp[d][b] = grad[d];
+        }
+
+        // The current iterate and the history at this point.
+        dealii::Tensor<1, dim> u, u_history;
+        dealii::Tensor<2, dim> grad_u;
+        double                 p = 0;
+        dealii::Tensor<1, dim> grad_p;
+        for (unsigned int a = 0; a < n_s; ++a)
+          for (unsigned int c = 0; c < dim; ++c)
+          {
+            const unsigned int k = velocity_dof[a][c];
+            u[c] += local_solution[k] * N[a];
+            for (unsigned int d = 0; d < dim; ++d)
+              grad_u[c][d] += local_solution[k] * G[d][a];
+            if (inv_dt > 0)
+              u_history[c] +=
+                (bdf[1] * local_old[k] + bdf[2] * local_older[k]) * N[a];
+          }
+        for (unsigned int b = 0; b < n_p; ++b)
+        {
+          const double value = local_solution[pressure_dof[b]];
+          p += value * Np[b];
+          for (unsigned int d = 0; d < dim; ++d)
+            grad_p[d] += value * Gp[d][b];
+        }
+
         const double phi      = mixture.fluid_fraction[q];
         const auto  &grad_phi = mixture.fluid_fraction_gradient[q];
         const double beta     = mixture.drag_coefficient[q];
@@ -271,62 +345,100 @@ namespace ImmersedGrains
         const double mass     = phi * rho * bdf[0] * inv_dt;
         const double JxW      = fe_values.JxW(q);
 
-        for (unsigned int k = 0; k < dofs_per_cell; ++k)
-        {
-          phi_u[k]      = fe_values[velocities].value(k, q);
-          grad_phi_u[k] = fe_values[velocities].gradient(k, q);
-          div_phi_u[k]  = fe_values[velocities].divergence(k, q);
-          phi_p[k]      = fe_values[pressure].value(k, q);
-          grad_phi_p[k] = fe_values[pressure].gradient(k, q);
-        }
-
         // Strong-form pieces of the residual at this point.
         dealii::Tensor<1, dim> momentum =
-          phi * rho * inv_dt *
-            (bdf[0] * u[q] + bdf[1] * u_old[q] + bdf[2] * u_older[q]) +
-          beta * (u[q] - mixture.grain_velocity[q]) + alpha * grad_p[q];
+          phi * rho * inv_dt * (bdf[0] * u + u_history) +
+          beta * (u - mixture.grain_velocity[q]) + alpha * grad_p;
         if (advection)
-          momentum += phi * rho * (grad_u[q] * u[q]);
+          momentum += phi * rho * (grad_u * u);
         for (unsigned int d = 0; d < dim; ++d)
           momentum[d] -= f[q](d);
-        const dealii::Tensor<2, dim> viscous = phi * mu * grad_u[q];
+        const dealii::Tensor<2, dim> viscous = phi * mu * grad_u;
         // The solid flux enters integrated by parts, (grad q, s): its
         // normal component is then zero on walls, where grains cannot pass,
         // and the continuity equation stays compatible with a pressure
         // fixed only up to a constant.
-        const double continuity = phi * dealii::trace(grad_u[q]) +
-                                  grad_phi * u[q] - mixture.mass_source[q];
+        const double continuity =
+          phi * dealii::trace(grad_u) + grad_phi * u - mixture.mass_source[q];
         const dealii::Tensor<1, dim> solid_flux =
-          mixture.solid_flux[q] + alpha * u[q] - mobility * grad_p[q];
+          mixture.solid_flux[q] + alpha * u - mobility * grad_p;
 
-        for (unsigned int i = 0; i < dofs_per_cell; ++i)
-        {
-          const double div_phi_v = phi * div_phi_u[i] + grad_phi * phi_u[i];
-          cell_rhs(i) -=
-            (momentum * phi_u[i] +
-             dealii::scalar_product(viscous, grad_phi_u[i]) - p[q] * div_phi_v -
-             phi_p[i] * continuity + grad_phi_p[i] * solid_flux) *
-            JxW;
-
-          for (unsigned int j = 0; j < dofs_per_cell; ++j)
+        // Velocity rows: momentum and viscous stress against N_a, pressure
+        // against div(phi N_a e_c) = phi dN_a/dx_c + dphi/dx_c N_a.
+        for (unsigned int a = 0; a < n_s; ++a)
+          for (unsigned int c = 0; c < dim; ++c)
           {
-            dealii::Tensor<1, dim> a = (mass + beta) * phi_u[j];
-            if (advection)
-            {
-              a += phi * rho * (grad_phi_u[j] * u[q]);
-              if (newton)
-                a += phi * rho * (grad_u[q] * phi_u[j]);
-            }
-            const double div_phi_uj = phi * div_phi_u[j] + grad_phi * phi_u[j];
-            cell_matrix(i, j) +=
-              (a * phi_u[i] +
-               phi * mu * dealii::scalar_product(grad_phi_u[j], grad_phi_u[i]) -
-               phi_p[j] * div_phi_v - phi_p[i] * div_phi_uj +
-               alpha * (grad_phi_p[j] * phi_u[i] + grad_phi_p[i] * phi_u[j]) -
-               mobility * (grad_phi_p[i] * grad_phi_p[j])) *
-              JxW;
+            double viscous_a = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              viscous_a += viscous[c][d] * G[d][a];
+            rhs_u[a][c] -= (momentum[c] * N[a] + viscous_a -
+                            p * (phi * G[c][a] + grad_phi[c] * N[a])) *
+                           JxW;
+          }
+        for (unsigned int b = 0; b < n_p; ++b)
+        {
+          double flux_b = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            flux_b += Gp[d][b] * solid_flux[d];
+          rhs_p[b] -= (-Np[b] * continuity + flux_b) * JxW;
+        }
+
+        // K_ab += (mass + beta) N_a N_b + phi mu grad N_a . grad N_b
+        //       + phi rho (u . grad N_b) N_a.
+        const double w_mass    = (mass + beta) * JxW;
+        const double w_viscous = phi * mu * JxW;
+        for (unsigned int b = 0; b < n_s; ++b)
+        {
+          double adv = 0;
+          if (advection)
+            for (unsigned int d = 0; d < dim; ++d)
+              adv += u[d] * G[d][b];
+          advection_weight[b] = w_mass * N[b] + phi * rho * adv * JxW;
+        }
+        for (unsigned int a = 0; a < n_s; ++a)
+        {
+          double *row = &K[a * n_s];
+          for (unsigned int b = 0; b < n_s; ++b)
+          {
+            double g = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              g += G[d][a] * G[d][b];
+            row[b] += N[a] * advection_weight[b] + w_viscous * g;
           }
         }
+        if (newton)
+          // phi rho (grad u)_cd N_b N_a couples component c of the row
+          // with component d of the column.
+          for (unsigned int c = 0; c < dim; ++c)
+            for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double w     = phi * rho * grad_u[c][d] * JxW;
+              double      *block = &W[(c * dim + d) * n_s * n_s];
+              for (unsigned int a = 0; a < n_s; ++a)
+                for (unsigned int b = 0; b < n_s; ++b)
+                  block[a * n_s + b] += w * N[a] * N[b];
+            }
+
+        // B_{c,ab} = -Np_b (phi dN_a/dx_c + dphi/dx_c N_a)
+        //          + alpha dNp_b/dx_c N_a.
+        for (unsigned int c = 0; c < dim; ++c)
+          for (unsigned int a = 0; a < n_s; ++a)
+          {
+            const double div_a   = (phi * G[c][a] + grad_phi[c] * N[a]) * JxW;
+            const double alpha_a = alpha * N[a] * JxW;
+            double      *row     = &B[(c * n_s + a) * n_p];
+            for (unsigned int b = 0; b < n_p; ++b)
+              row[b] += -Np[b] * div_a + alpha_a * Gp[c][b];
+          }
+        if (mobility != 0)
+          for (unsigned int b = 0; b < n_p; ++b)
+            for (unsigned int e = 0; e < n_p; ++e)
+            {
+              double g = 0;
+              for (unsigned int d = 0; d < dim; ++d)
+                g += Gp[d][b] * Gp[d][e];
+              C[b * n_p + e] -= mobility * g * JxW;
+            }
 
         if (assemble_preconditioner_matrices)
         {
@@ -334,28 +446,60 @@ namespace ImmersedGrains
           // needs the pressure mass matrix weighted by phi/mu and the
           // diagonal of the mass-and-drag part c M of A,
           // c = phi rho a0/dt + beta, plus its floor (schur_floor_factor).
-          const double mass_weight = phi / mu;
+          const double mass_weight = phi / mu * JxW;
           cell_drag += beta * JxW;
           cell_viscosity += phi * mu * JxW;
           max_beta = std::max(max_beta, beta);
-          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+          for (unsigned int b = 0; b < n_p; ++b)
+            for (unsigned int e = 0; e < n_p; ++e)
+              Mp[b * n_p + e] += mass_weight * Np[b] * Np[e];
+          for (unsigned int a = 0; a < n_s; ++a)
           {
-            const unsigned int component =
-              fe.system_to_component_index(i).first;
-            if (component == dim)
-            {
-              for (unsigned int j = 0; j < dofs_per_cell; ++j)
-                if (fe.system_to_component_index(j).first == dim)
-                  cell_mass(i, j) += mass_weight * phi_p[i] * phi_p[j] * JxW;
-            }
-            else
-              cell_reaction(i) +=
-                ((mass + beta) * phi_u[i][component] * phi_u[i][component] +
-                 floor_factor * phi * mu *
-                   grad_phi_u[i][component].norm_square()) *
-                JxW;
+            double g = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              g += G[d][a] * G[d][a];
+            R[a] += w_mass * N[a] * N[a] + floor_factor * w_viscous * g;
           }
         }
+      }
+
+      // The scalar integrals onto the vector-valued cell matrix.
+      cell_matrix = 0;
+      for (unsigned int c = 0; c < dim; ++c)
+        for (unsigned int a = 0; a < n_s; ++a)
+        {
+          const unsigned int i = velocity_dof[a][c];
+          cell_rhs(i)          = rhs_u[a][c];
+          for (unsigned int b = 0; b < n_s; ++b)
+            cell_matrix(i, velocity_dof[b][c]) = K[a * n_s + b];
+          if (newton)
+            for (unsigned int d = 0; d < dim; ++d)
+              for (unsigned int b = 0; b < n_s; ++b)
+                cell_matrix(i, velocity_dof[b][d]) +=
+                  W[(c * dim + d) * n_s * n_s + a * n_s + b];
+          for (unsigned int b = 0; b < n_p; ++b)
+          {
+            const double value              = B[(c * n_s + a) * n_p + b];
+            cell_matrix(i, pressure_dof[b]) = value;
+            cell_matrix(pressure_dof[b], i) = value;
+          }
+        }
+      for (unsigned int b = 0; b < n_p; ++b)
+      {
+        cell_rhs(pressure_dof[b]) = rhs_p[b];
+        for (unsigned int e = 0; e < n_p; ++e)
+          cell_matrix(pressure_dof[b], pressure_dof[e]) = C[b * n_p + e];
+      }
+      if (assemble_preconditioner_matrices)
+      {
+        cell_mass     = 0;
+        cell_reaction = 0;
+        for (unsigned int b = 0; b < n_p; ++b)
+          for (unsigned int e = 0; e < n_p; ++e)
+            cell_mass(pressure_dof[b], pressure_dof[e]) = Mp[b * n_p + e];
+        for (unsigned int a = 0; a < n_s; ++a)
+          for (unsigned int c = 0; c < dim; ++c)
+            cell_reaction(velocity_dof[a][c]) = R[a];
       }
 
       // Grains in this cell: beta_i (u(x_i) - v_i) . N_k(x_i), implicit.
@@ -367,19 +511,34 @@ namespace ImmersedGrains
         {
           // The cell averages of the velocity shape functions: the drag of
           // each grain spread evenly over its cell and felt against the
-          // cell-mean velocity.
+          // cell-mean velocity. Every grain of the cell has the same
+          // shape, so their drags add up to one: sum beta_i against the
+          // cell-mean velocity minus sum beta_i v_i.
           double volume = 0;
           std::fill(point_shape.begin(), point_shape.end(), 0.0);
           for (unsigned int q = 0; q < n_q; ++q)
           {
             volume += fe_values.JxW(q);
-            for (unsigned int k = 0; k < dofs_per_cell; ++k)
-              if (fe.system_to_component_index(k).first < dim)
-                point_shape[k] +=
-                  fe_values.shape_value(k, q) * fe_values.JxW(q);
+            for (unsigned int a = 0; a < n_s; ++a)
+              point_shape[velocity_dof[a][0]] +=
+                fe_values.shape_value(velocity_dof[a][0], q) * fe_values.JxW(q);
           }
-          for (auto &v : point_shape)
-            v /= volume;
+          for (unsigned int a = 0; a < n_s; ++a)
+          {
+            const double mean = point_shape[velocity_dof[a][0]] / volume;
+            for (unsigned int c = 0; c < dim; ++c)
+              point_shape[velocity_dof[a][c]] = mean;
+          }
+          PointDrag<dim> total;
+          total.beta = 0;
+          for (const auto &drag : drags)
+          {
+            total.beta += drag.beta;
+            total.velocity += drag.beta * drag.velocity;
+            max_beta = std::max(max_beta, drag.beta);
+          }
+          // total.velocity holds sum beta_i v_i.
+          drags.assign(1, total);
         }
         for (const auto &drag : drags)
         {
@@ -395,13 +554,17 @@ namespace ImmersedGrains
             if (point_shape[k] != 0)
               u_at_grain[fe.system_to_component_index(k).first] +=
                 local_solution[k] * point_shape[k];
-          const dealii::Tensor<1, dim> slip = u_at_grain - drag.velocity;
+          // The slip force beta (u - v); with the cell's grains summed,
+          // sum beta_i u - sum beta_i v_i.
+          const dealii::Tensor<1, dim> force =
+            cell_averaged_drag ? drag.beta * u_at_grain - drag.velocity :
+                                 drag.beta * (u_at_grain - drag.velocity);
           for (unsigned int i = 0; i < dofs_per_cell; ++i)
           {
             if (point_shape[i] == 0)
               continue;
             const unsigned int ci = fe.system_to_component_index(i).first;
-            cell_rhs(i) -= drag.beta * slip[ci] * point_shape[i];
+            cell_rhs(i) -= force[ci] * point_shape[i];
             for (unsigned int j = 0; j < dofs_per_cell; ++j)
               if (point_shape[j] != 0 &&
                   fe.system_to_component_index(j).first == ci)
@@ -450,7 +613,6 @@ namespace ImmersedGrains
         }
       }
 
-      cell->get_dof_indices(dof_indices);
       update_constraints.distribute_local_to_global(
         cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
       if (assemble_preconditioner_matrices)

@@ -19,6 +19,8 @@ namespace ImmersedGrains
   FluidSolver<dim>::build_preconditioner()
   {
     dealii::TimerOutput::Scope scope(timer, "fluid: preconditioner");
+    rebuild_requested      = false;
+    built_mass_coefficient = mass_coefficient();
 
     BlockSchurPreconditioner::Settings settings;
     settings.velocity_cycles          = parameters.velocity_amg_cycles;
@@ -169,7 +171,8 @@ namespace ImmersedGrains
 
   template <int dim>
   unsigned int
-  FluidSolver<dim>::solve_linear_system(const double absolute_tolerance)
+  FluidSolver<dim>::solve_linear_system(const double absolute_tolerance,
+                                        const bool   fresh_preconditioner)
   {
     if (parameters.direct_solver)
     {
@@ -203,8 +206,8 @@ namespace ImmersedGrains
       return 1;
     }
 
-    build_preconditioner();
-    dealii::TimerOutput::Scope scope(timer, "fluid: solve");
+    if (fresh_preconditioner)
+      build_preconditioner();
     // Relative to this system's right-hand side, but no tighter than the
     // nonlinear iteration needs: late Picard/Newton corrections are tiny.
     const double tolerance =
@@ -213,26 +216,43 @@ namespace ImmersedGrains
     dealii::SolverControl control(parameters.max_linear_iterations, tolerance);
     dealii::SolverFGMRES<VectorType> solver(
       control, typename dealii::SolverFGMRES<VectorType>::AdditionalData(100));
-    newton_update = 0;
+    unsigned int failed_iterations = 0;
     try
     {
+      dealii::TimerOutput::Scope scope(timer, "fluid: solve");
+      newton_update = 0;
       solver.solve(system_matrix, newton_update, system_rhs, *preconditioner);
     }
     catch (const dealii::SolverControl::NoConvergence &e)
     {
-      AssertThrow(false,
-                  dealii::ExcMessage(
-                    "Fluid: FGMRES did not converge in " +
-                    std::to_string(e.last_step) + " iterations (residual " +
-                    [&]
-                    {
-                      std::ostringstream r;
-                      r << e.last_residual;
-                      return r.str();
-                    }() +
-                    ", Fluid/Linear solver/Max iterations = " +
-                    std::to_string(parameters.max_linear_iterations) + ")."));
+      if (fresh_preconditioner)
+        AssertThrow(false,
+                    dealii::ExcMessage(
+                      "Fluid: FGMRES did not converge in " +
+                      std::to_string(e.last_step) + " iterations (residual " +
+                      [&]
+                      {
+                        std::ostringstream r;
+                        r << e.last_residual;
+                        return r.str();
+                      }() +
+                      ", Fluid/Linear solver/Max iterations = " +
+                      std::to_string(parameters.max_linear_iterations) + ")."));
+      // A kept preconditioner that no longer fits: build a fresh one (its
+      // matrices were not assembled this time) and solve again.
+      failed_iterations = e.last_step;
+      assemble_system(true);
+      return failed_iterations + solve_linear_system(absolute_tolerance, true);
     }
+
+    // A solve right after a rebuild sets the yardstick; one with a kept
+    // preconditioner that takes clearly longer asks for a rebuild.
+    if (fresh_preconditioner)
+      iterations_after_rebuild = control.last_step();
+    else if (control.last_step() > parameters.preconditioner_rebuild_ratio *
+                                       iterations_after_rebuild +
+                                     3)
+      rebuild_requested = true;
     return control.last_step();
   }
 
@@ -242,7 +262,7 @@ namespace ImmersedGrains
   template void
   FluidSolver<3>::build_preconditioner();
   template unsigned int
-  FluidSolver<2>::solve_linear_system(double);
+  FluidSolver<2>::solve_linear_system(double, bool);
   template unsigned int
-  FluidSolver<3>::solve_linear_system(double);
+  FluidSolver<3>::solve_linear_system(double, bool);
 } // namespace ImmersedGrains

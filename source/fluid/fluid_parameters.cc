@@ -177,6 +177,17 @@ namespace ImmersedGrains
           "several ranks the ILU is block-Jacobi, and a single one cost up "
           "to 50% more outer iterations than on one rank "
           "(doc/benchmarks.md).");
+        prm.declare_entry(
+          "Preconditioner rebuild ratio",
+          "1.5",
+          Double(0),
+          "The preconditioner (AMG hierarchies, Schur complement pieces) is "
+          "kept across nonlinear iterations and time steps and rebuilt when "
+          "a solve takes more than this many times the iterations of the "
+          "first solve after the last rebuild (plus 3), when the mass "
+          "coefficient rho a0/dt changes by more than 25%, when a solve "
+          "fails, or after a mesh change. 0: rebuilt before every solve "
+          "(doc/performance.md).");
       }
       prm.leave_subsection();
 
@@ -244,6 +255,8 @@ namespace ImmersedGrains
           prm.get_integer("Velocity inner iterations");
         velocity_inner_tolerance = prm.get_double("Velocity inner tolerance");
         pressure_mass_iterations = prm.get_integer("Pressure mass iterations");
+        preconditioner_rebuild_ratio =
+          prm.get_double("Preconditioner rebuild ratio");
         where.require(velocity_inner_tolerance < 1,
                       "Linear solver/Velocity inner tolerance",
                       prm.get("Velocity inner tolerance"),

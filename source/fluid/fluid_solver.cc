@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_renumbering.h>
 #include <deal.II/dofs/dof_tools.h>
@@ -106,6 +108,9 @@ namespace ImmersedGrains
       , mpi_communicator(triangulation.get_communicator())
       , fe(dealii::FE_Q<dim>(2), dim, dealii::FE_Q<dim>(1), 1)
       , dof_handler(triangulation)
+      , velocity_shapes(fe.base_element(0))
+      , pressure_shapes(fe.base_element(1))
+      , mean_shapes(fe.base_element(0))
       , forcing(parameters.forcing)
       , boundary_velocity(parameters.boundary_velocity)
   {
@@ -150,45 +155,41 @@ namespace ImmersedGrains
       &triangulation, tria_cell->level(), tria_cell->index(), &dof_handler);
     std::vector<dealii::types::global_dof_index> indices(fe.n_dofs_per_cell());
     cell->get_dof_indices(indices);
-    const dealii::Quadrature<dim> points(reference_locations);
-    dealii::FEValues<dim>         fe_values(
-      mapping, fe, points, dealii::update_values | dealii::update_gradients);
-    fe_values.reinit(cell);
+    // The scalar Q2 (velocity) and Q1 (pressure) functions at the points:
+    // one pass over each, no FEValues set up per call.
+    velocity_shapes.reinit(cell, reference_locations, false);
+    pressure_shapes.reinit(cell, reference_locations, true);
     std::vector<PointValues> values(reference_locations.size());
     for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
     {
-      const double       coefficient = solution(indices[i]);
-      const unsigned int component   = fe.system_to_component_index(i).first;
+      const double coefficient      = solution(indices[i]);
+      const auto [component, index] = fe.system_to_component_index(i);
       for (unsigned int q = 0; q < values.size(); ++q)
         if (component < dim)
           values[q].velocity[component] +=
-            coefficient * fe_values.shape_value(i, q);
+            coefficient * velocity_shapes.value(index, q);
         else
           values[q].pressure_gradient +=
-            coefficient * fe_values.shape_grad(i, q);
+            coefficient * pressure_shapes.gradient(index, q);
     }
     if (cell_averaged_drag)
     {
       // The cell-mean velocity, the one the averaged drag is felt against.
       const dealii::QGauss<dim> quadrature(fe.degree + 1);
-      dealii::FEValues<dim>     cell_values(mapping,
-                                        fe,
-                                        quadrature,
-                                        dealii::update_values |
-                                          dealii::update_JxW_values);
-      cell_values.reinit(cell);
+      mean_shapes.reinit(cell, quadrature.get_points(), true);
       dealii::Tensor<1, dim> mean;
       double                 volume = 0;
       for (unsigned int q = 0; q < quadrature.size(); ++q)
       {
-        volume += cell_values.JxW(q);
+        const double JxW =
+          quadrature.weight(q) * mean_shapes.jacobian_determinant(q);
+        volume += JxW;
         for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
         {
-          const unsigned int component = fe.system_to_component_index(i).first;
+          const auto [component, index] = fe.system_to_component_index(i);
           if (component < dim)
-            mean[component] += solution(indices[i]) *
-                               cell_values.shape_value(i, q) *
-                               cell_values.JxW(q);
+            mean[component] +=
+              solution(indices[i]) * mean_shapes.value(index, q) * JxW;
         }
       }
       for (auto &v : values)
@@ -445,7 +446,11 @@ namespace ImmersedGrains
     old_old_solution = old_solution;
     old_solution     = solution;
 
-    // Start from the extrapolated state and the new boundary data.
+    // Start from the extrapolated state and the new boundary data (only
+    // velocity faces carry data that depends on time).
+    if (std::find(geometry.boundary_types.begin(),
+                  geometry.boundary_types.end(),
+                  BoundaryType::velocity) != geometry.boundary_types.end())
     {
       dealii::TimerOutput::Scope scope(timer, "fluid: setup");
       make_constraints();
@@ -467,7 +472,8 @@ namespace ImmersedGrains
     bool           converged = false;
     for (unsigned int k = 0; k < parameters.max_nonlinear_iterations; ++k)
     {
-      assemble_system(true);
+      const bool fresh_preconditioner = preconditioner_due();
+      assemble_system(fresh_preconditioner);
       const double residual = system_rhs.l2_norm();
       if (k == 0)
         stats.initial_residual = residual;
@@ -489,7 +495,8 @@ namespace ImmersedGrains
 
       stats.linear_iterations += solve_linear_system(
         std::max(0.1 * parameters.nonlinear_tolerance * stats.initial_residual,
-                 0.1 * parameters.linear_tolerance * rhs_norm));
+                 0.1 * parameters.linear_tolerance * rhs_norm),
+        fresh_preconditioner);
       ++stats.nonlinear_iterations;
       update_constraints.distribute(newton_update);
       iterate.add(1.0, newton_update);
@@ -512,6 +519,30 @@ namespace ImmersedGrains
     solution = iterate;
     ++steps_done;
     return stats;
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::mass_coefficient() const
+  {
+    return parameters.time_derivative && dt > 0 ? bdf[0] / dt : 0.0;
+  }
+
+
+  template <int dim>
+  bool
+  FluidSolver<dim>::preconditioner_due() const
+  {
+    if (parameters.direct_solver)
+      return false;
+    if (!preconditioner || rebuild_requested ||
+        parameters.preconditioner_rebuild_ratio == 0)
+      return true;
+    // The mass term rho a0/dt enters A and both Schur terms; a step size
+    // that changes it much makes the old hierarchy a poor one.
+    const double now = mass_coefficient(), then = built_mass_coefficient;
+    return std::abs(now - then) > 0.25 * std::max(now, then);
   }
 
 
@@ -659,6 +690,14 @@ namespace ImmersedGrains
     output_fields =
       std::make_unique<MixtureFieldsOutput<dim>>(*mixture_fields, time);
     data_out.add_data_vector(dof_handler, solution, *output_fields);
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::max_velocity() const
+  {
+    return solution.block(0).linfty_norm();
   }
 
 

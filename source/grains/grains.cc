@@ -264,6 +264,23 @@ namespace ImmersedGrains
 
   template <int dim>
   double
+  Grains<dim>::max_speed() const
+  {
+    double v_max = 0;
+    for (const auto &p : particles)
+    {
+      const auto             props = p.get_properties();
+      dealii::Tensor<1, dim> v;
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = props[properties.velocity + d];
+      v_max = std::max(v_max, v.norm());
+    }
+    return dealii::Utilities::MPI::max(v_max, comm);
+  }
+
+
+  template <int dim>
+  double
   Grains<dim>::longest_step(const double v_max, const double r_min) const
   {
     // The ParticleHandler looks for a moved grain in the cells around its

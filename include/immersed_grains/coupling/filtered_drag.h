@@ -6,6 +6,7 @@
 
 #include <immersed_grains/coupling/helmholtz_filter.h>
 #include <immersed_grains/fluid/mixture_fields.h>
+#include <immersed_grains/mesh/cell_point_shapes.h>
 
 #include <array>
 #include <functional>
@@ -123,7 +124,10 @@ namespace ImmersedGrains
       const std::vector<dealii::Point<dim>> &reference_points,
       const std::array<typename HelmholtzFilter<dim>::Vector, dim> &) const;
 
-    HelmholtzFilter<dim>                  filter;
+    HelmholtzFilter<dim> filter;
+
+    // The filter's Q1 shapes at the points last asked for.
+    mutable CellPointShapes<dim>          shapes;
     const double                          length;
     const bool                            drag_as_field;
     const bool                            implicit_velocity;

@@ -8,6 +8,7 @@
 
 #include <immersed_grains/coupling/helmholtz_filter.h>
 #include <immersed_grains/fluid/mixture_fields.h>
+#include <immersed_grains/mesh/cell_point_shapes.h>
 #include <immersed_grains/mesh/geometry.h>
 
 #include <array>
@@ -118,8 +119,10 @@ namespace ImmersedGrains
     solid_fraction() const;
 
   private:
-    const Parameters                                      &parameters;
-    HelmholtzFilter<dim>                                   filter;
+    const Parameters    &parameters;
+    HelmholtzFilter<dim> filter;
+    // The filter's Q1 shapes at the points last asked for.
+    mutable CellPointShapes<dim>                           shapes;
     typename HelmholtzFilter<dim>::Vector                  fraction;
     typename HelmholtzFilter<dim>::Vector                  felt; // smoothing
     std::array<typename HelmholtzFilter<dim>::Vector, dim> flux;

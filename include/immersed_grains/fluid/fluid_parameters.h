@@ -62,10 +62,11 @@ namespace ImmersedGrains
     unsigned int       max_linear_iterations = 500;
     SchurApproximation schur_approximation =
       SchurApproximation::cahouet_chabard;
-    unsigned int velocity_amg_cycles       = 2;
-    unsigned int velocity_inner_iterations = 0;
-    double       velocity_inner_tolerance  = 1e-6;
-    unsigned int pressure_mass_iterations  = 3;
+    unsigned int velocity_amg_cycles          = 2;
+    unsigned int velocity_inner_iterations    = 0;
+    double       velocity_inner_tolerance     = 1e-6;
+    unsigned int pressure_mass_iterations     = 3;
+    double       preconditioner_rebuild_ratio = 1.5; // 0: every solve
 
     // Prescribed fields; shared so that a test can substitute exact ones.
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> fluid_fraction;

@@ -16,6 +16,7 @@
 
 #include <immersed_grains/fluid/fluid_parameters.h>
 #include <immersed_grains/fluid/mixture_fields.h>
+#include <immersed_grains/mesh/cell_point_shapes.h>
 #include <immersed_grains/mesh/geometry.h>
 
 #include <memory>
@@ -123,6 +124,10 @@ namespace ImmersedGrains
     double
     pressure_at(const dealii::Point<dim> &point) const;
 
+    /** The largest velocity component at a node (collective). */
+    double
+    max_velocity() const;
+
     /** Integral of the fluid fraction over the mesh. */
     double
     integrate_fluid_fraction() const;
@@ -146,8 +151,20 @@ namespace ImmersedGrains
     void
     assemble_system(bool assemble_preconditioner_matrices);
 
+    // Solves for newton_update; with @p fresh_preconditioner the
+    // preconditioner is built first (its matrices must have been
+    // assembled), else the kept one is used.
     unsigned int
-    solve_linear_system(double absolute_tolerance);
+    solve_linear_system(double absolute_tolerance, bool fresh_preconditioner);
+
+    // Whether the next solve needs a new preconditioner (the entry
+    // Preconditioner rebuild ratio).
+    bool
+    preconditioner_due() const;
+
+    // rho-free mass coefficient a0/dt of the current step (0 if steady).
+    double
+    mass_coefficient() const;
 
     // |A x + r| over the unconstrained rows, with A and r = system_rhs as
     // assembled at the iterate x: the size of the right-hand side.
@@ -196,6 +213,10 @@ namespace ImmersedGrains
     VectorType system_rhs;       // owned: minus the residual
     VectorType newton_update;    // owned
 
+    // Shape functions at grain positions (point_values); the Q2 ones also at
+    // the Gauss points for cell means.
+    mutable CellPointShapes<dim> velocity_shapes, pressure_shapes, mean_shapes;
+
     std::shared_ptr<const MixtureFields<dim>>   mixture_fields;
     std::shared_ptr<const PointDragSource<dim>> point_drag_source;
     bool                                        cell_averaged_drag = false;
@@ -214,6 +235,12 @@ namespace ImmersedGrains
     // Whether any drag is present; without it and without inertia (steady
     // Stokes) the Laplacian term of the Schur approximation is left out.
     bool schur_has_drag = false;
+    // Preconditioner reuse: the iterations of the first solve after the
+    // last rebuild, whether a slower solve asked for a new one, and the
+    // mass coefficient it was built for.
+    unsigned int iterations_after_rebuild = 0;
+    bool         rebuild_requested        = false;
+    double       built_mass_coefficient   = 0;
 
     // DataOut keeps a pointer to the postprocessor until patches are built.
     mutable std::unique_ptr<dealii::DataPostprocessor<dim>> output_fields;

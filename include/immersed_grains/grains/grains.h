@@ -152,6 +152,17 @@ namespace ImmersedGrains
     double
     stable_time_step(double max_step) const;
 
+    /** The largest grain speed (collective). */
+    double
+    max_speed() const;
+
+    /** The shortest cell edge of the mesh the grains live on. */
+    double
+    shortest_cell_edge() const
+    {
+      return min_cell_size;
+    }
+
     GrainStepReport
     advance(double dt);
 
