@@ -5,13 +5,16 @@
 #include <immersed_grains/grains/grains.h>
 #include <immersed_grains/io/field_output.h>
 #include <immersed_grains/io/particle_output.h>
+#include <immersed_grains/mesh/size_estimate.h>
 #include <immersed_grains/simulation.h>
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 
 namespace ImmersedGrains
 {
@@ -139,7 +142,7 @@ namespace ImmersedGrains
       "half the shortest cell edge, in one step.");
     prm.declare_entry(
       "Courant number",
-      "0.25",
+      "0.1",
       Double(0),
       "With Adaptive time step: the largest fraction of the shortest cell "
       "edge that grains (and, with advection, the fluid) cross in one fluid "
@@ -271,6 +274,26 @@ namespace ImmersedGrains
     coupling_parameters.parse_parameters(prm, file);
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
+
+    // Stop here, before anything large is allocated or written, if the
+    // scene cannot fit: the kernel would kill it half-way instead.
+    size_estimate =
+      estimate_size(geometry, fluid_parameters.enabled, grain_seeds.size());
+    available_memory = machine_memory(comm);
+    if (size_estimate.peak_bytes > 0.9 * available_memory)
+    {
+      std::ostringstream problem;
+      problem << std::setprecision(3) << size_estimate.cells << " cells and "
+              << size_estimate.dofs << " DoFs need about "
+              << size_estimate.peak_bytes / (1 << 30) << " GiB, more than the "
+              << available_memory / (1 << 30)
+              << " GiB of memory here; lower it or Mesh/Subdivisions ("
+              << prm.get({"Mesh"}, "Subdivisions") << ")";
+      InputLocation{file, "Mesh"}.fail("Initial refinement",
+                                       std::to_string(
+                                         geometry.initial_refinement),
+                                       problem.str());
+    }
   }
 
 
@@ -330,6 +353,11 @@ namespace ImmersedGrains
     for (const auto t : geometry.boundary_types)
       pcout << ' ' << to_string(t);
     pcout << '\n';
+    pcout << "  estimate: " << size_estimate.cells << " cells, "
+          << size_estimate.dofs << " DoFs, peak memory about "
+          << std::setprecision(3) << size_estimate.peak_bytes / (1 << 30)
+          << " GiB of " << available_memory / (1 << 30) << " GiB\n"
+          << std::setprecision(6);
 
     if (fluid_parameters.enabled)
     {
@@ -458,7 +486,12 @@ namespace ImmersedGrains
           dt = std::min(dt, courant_number * shortest_cell_edge / u);
       }
     }
-    return std::min(dt, end_time - time);
+    // An adaptive run does not end on a sliver: what is left of the run,
+    // if less than two steps, is split into two equal ones.
+    const double remaining = end_time - time;
+    if (adaptive_time_step && remaining > dt * (1 + 1e-6) && remaining < 2 * dt)
+      dt = remaining / 2;
+    return std::min(dt, remaining);
   }
 
 

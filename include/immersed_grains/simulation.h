@@ -14,6 +14,7 @@
 #include <immersed_grains/io/statistics.h>
 #include <immersed_grains/io/test_checks.h>
 #include <immersed_grains/mesh/geometry.h>
+#include <immersed_grains/mesh/size_estimate.h>
 
 #include <map>
 #include <memory>
@@ -83,7 +84,7 @@ namespace ImmersedGrains
     double      end_time           = 1;
     double      time_step          = 1;
     bool        adaptive_time_step = false;
-    double      courant_number     = 0.25;
+    double      courant_number     = 0.1;
     double      shortest_cell_edge = 0;
 
     unsigned int                    write_fields_every = 0;
@@ -102,6 +103,8 @@ namespace ImmersedGrains
     typename Coupling<dim>::Parameters coupling_parameters;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
+    SizeEstimate                size_estimate;
+    double                      available_memory = 0;
 
     RunLog                               log;
     dealii::ConditionalOStream           pcout;
