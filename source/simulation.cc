@@ -70,6 +70,7 @@ namespace ImmersedGrains
       for (int d = 0; d < dim; ++d)
         c.push_back(std::string("fixed_centroid_") + axes[d]);
       c.emplace_back("drag_averaged_cells");
+      c.emplace_back("preconditioner_builds"); // cumulative
       return c;
     }
 
@@ -514,6 +515,8 @@ namespace ImmersedGrains
       statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
       statistics.set("fluid_residual", stats.final_residual);
       statistics.set("drag_averaged_cells", stats.drag_averaged_cells);
+      preconditioner_builds += stats.preconditioner_builds;
+      statistics.set("preconditioner_builds", preconditioner_builds);
     }
     if (grains && !coupling)
       record_grain_step(grains->advance(dt));
@@ -564,6 +567,8 @@ namespace ImmersedGrains
     statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
     statistics.set("fluid_residual", stats.final_residual);
     statistics.set("drag_averaged_cells", stats.drag_averaged_cells);
+    preconditioner_builds += stats.preconditioner_builds;
+    statistics.set("preconditioner_builds", preconditioner_builds);
     coupling->set_grain_forces(*grains, *fluid, dt);
     grains->compute_free_velocities(dt);
     // Grains that this step would move too far take equal sub-steps

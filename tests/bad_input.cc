@@ -203,6 +203,21 @@ end
              "maybe\nend\n",
          "Implicit coupling",
          "maybe"},
+        // 8^3 cells refined 3 times, Q2-Q1: 6.7 million DoFs, about 38
+        // GiB; stopped by the memory estimate before anything is
+        // allocated (any machine this suite runs on has less than 1 TiB:
+        // refinement 5 asks for about 2.4 TiB).
+        {"mesh_too_large",
+         "set Dimension = 3\nsubsection Mesh\n  set Lower corner = 0, 0, 0\n  "
+             "set Upper corner = 1, 1, 1\n  set Subdivisions = 8, 8, 8\n  set "
+             "Initial refinement = 5\nend\n",
+         "Initial refinement",
+         "5"},
+        {"nonpositive_courant_number",
+         "set Dimension = 2\nset Adaptive time step = true\nset Courant "
+             "number = 0\n",
+         "Courant number",
+         "0"},
   };
 
   unsigned int failures = 0;

@@ -95,7 +95,8 @@ namespace ImmersedGrains
     std::vector<TestCheck>          test_checks;
     std::vector<dealii::Point<dim>> pressure_drop_points;
     std::string                     pressure_drop_text;
-    unsigned int                    clamped_nodes_before = 0;
+    unsigned int                    clamped_nodes_before  = 0;
+    unsigned int                    preconditioner_builds = 0;
 
     Geometry<dim>                      geometry;
     FluidParameters<dim>               fluid_parameters;

@@ -21,6 +21,7 @@ namespace ImmersedGrains
     dealii::TimerOutput::Scope scope(timer, "fluid: preconditioner");
     rebuild_requested      = false;
     built_mass_coefficient = mass_coefficient();
+    ++builds;
 
     BlockSchurPreconditioner::Settings settings;
     settings.velocity_cycles          = parameters.velocity_amg_cycles;

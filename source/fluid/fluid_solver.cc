@@ -478,9 +478,10 @@ namespace ImmersedGrains
     solution_constraints.distribute(iterate);
     solution = iterate;
 
-    StepStatistics stats;
-    const bool     linear    = !parameters.advection;
-    bool           converged = false;
+    StepStatistics     stats;
+    const unsigned int builds_before = builds;
+    const bool         linear        = !parameters.advection;
+    bool               converged     = false;
     for (unsigned int k = 0; k < parameters.max_nonlinear_iterations; ++k)
     {
       const bool fresh_preconditioner = preconditioner_due();
@@ -518,7 +519,8 @@ namespace ImmersedGrains
         break;
       }
     }
-    stats.drag_averaged_cells = drag_averaged_cells;
+    stats.drag_averaged_cells   = drag_averaged_cells;
+    stats.preconditioner_builds = builds - builds_before;
     AssertThrow(converged,
                 dealii::ExcMessage(
                   "Fluid: the nonlinear iteration did not converge in " +

@@ -105,6 +105,8 @@ namespace ImmersedGrains
       // drag coefficient against its own velocity, not the drag that a
       // filtered grain drag gives the grains.
       unsigned int drag_averaged_cells = 0;
+      // Preconditioners built in this step (0: the kept one served).
+      unsigned int preconditioner_builds = 0;
     };
 
     /** Advances from the current time to @p new_time = time + dt. */
@@ -239,6 +241,7 @@ namespace ImmersedGrains
     // last rebuild, whether a slower solve asked for a new one, and the
     // mass coefficient it was built for.
     unsigned int iterations_after_rebuild = 0;
+    unsigned int builds                   = 0; // since the start
     bool         rebuild_requested        = false;
     double       built_mass_coefficient   = 0;
 
