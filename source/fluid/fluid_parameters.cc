@@ -116,10 +116,18 @@ namespace ImmersedGrains
         "for a smooth beta the velocity converges at second instead of "
         "third order in L2. 'jump' converges like 'cell' on jumps and keeps "
         "the third order of 'quadrature' where beta is smooth on the mesh.");
-      prm.declare_entry("Linearization",
-                        "Picard",
-                        Selection("Picard|Newton"),
-                        "How the advection term is linearised.");
+      prm.declare_entry(
+        "Linearization",
+        "Extrapolated",
+        Selection("Extrapolated|Picard|Newton"),
+        "How the advection term is linearised. Extrapolated: one linear "
+        "solve per time step, advected by the velocity extrapolated from "
+        "the last two steps (u* = (1 + w) u^n - w u^{n-1}, w the step ratio; "
+        "second order with BDF2, semi-implicit, so the step must resolve "
+        "the flow: Adaptive time step keeps it within the Courant number). "
+        "Picard (Oseen) and Newton iterate to Nonlinear tolerance, several "
+        "assemblies and solves per step. A steady problem (Time derivative "
+        "= false) is solved by Picard iterations under Extrapolated too.");
       prm.declare_entry("Nonlinear tolerance",
                         "1e-8",
                         Double(0),
@@ -226,10 +234,11 @@ namespace ImmersedGrains
                     "Viscosity",
                     prm.get("Viscosity"),
                     "must be positive");
-      advection       = prm.get_bool("Advection");
-      time_derivative = prm.get_bool("Time derivative");
-      bdf_order       = prm.get("Time scheme") == "BDF2" ? 2 : 1;
-      newton          = prm.get("Linearization") == "Newton";
+      advection              = prm.get_bool("Advection");
+      time_derivative        = prm.get_bool("Time derivative");
+      bdf_order              = prm.get("Time scheme") == "BDF2" ? 2 : 1;
+      newton                 = prm.get("Linearization") == "Newton";
+      extrapolated_advection = prm.get("Linearization") == "Extrapolated";
       {
         const std::string averaging = prm.get("Drag coefficient averaging");
         drag_averaging = averaging == "cell" ? DragAveraging::cell :

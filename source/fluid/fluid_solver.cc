@@ -480,8 +480,13 @@ namespace ImmersedGrains
 
     StepStatistics     stats;
     const unsigned int builds_before = builds;
-    const bool         linear        = !parameters.advection;
-    bool               converged     = false;
+    // One Picard step from the extrapolated state is the semi-implicit
+    // scheme: the Oseen operator advected by u* applied to the unknown
+    // (the residual at u* is that operator's residual), solved once.
+    const bool linear =
+      !parameters.advection ||
+      (parameters.extrapolated_advection && parameters.time_derivative);
+    bool converged = false;
     for (unsigned int k = 0; k < parameters.max_nonlinear_iterations; ++k)
     {
       const bool fresh_preconditioner = preconditioner_due();

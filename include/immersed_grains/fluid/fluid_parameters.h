@@ -42,6 +42,8 @@ namespace ImmersedGrains
     bool         time_derivative = true;
     unsigned int bdf_order       = 2;
     bool         newton          = false;
+    // One solve per step with the extrapolated advecting velocity.
+    bool extrapolated_advection = true;
     // How the continuum drag is integrated (the entry "Drag coefficient
     // averaging").
     enum class DragAveraging
