@@ -1,4 +1,5 @@
 #include <deal.II/base/geometry_info.h>
+#include <deal.II/fe/fe_poly.h>
 
 #include <immersed_grains/mesh/cell_point_shapes.h>
 
@@ -28,12 +29,37 @@ namespace ImmersedGrains
       points = reference_points;
       values.resize(points.size() * n_dofs);
       reference_gradients.resize(points.size() * n_dofs);
+      // A polynomial element evaluates all its functions at once (each 1D
+      // polynomial once); shape_value() per function repeats that work
+      // n_dofs times, which showed in the grains' interaction force.
+      const auto *polynomial_fe =
+        dynamic_cast<const dealii::FE_Poly<dim> *>(&fe);
+      std::vector<double>                 point_values(n_dofs);
+      std::vector<dealii::Tensor<1, dim>> point_gradients(n_dofs);
+      std::vector<dealii::Tensor<2, dim>> no_second;
+      std::vector<dealii::Tensor<3, dim>> no_third;
+      std::vector<dealii::Tensor<4, dim>> no_fourth;
       for (unsigned int q = 0; q < points.size(); ++q)
+      {
+        if (polynomial_fe != nullptr)
+          polynomial_fe->get_poly_space().evaluate(points[q],
+                                                   point_values,
+                                                   point_gradients,
+                                                   no_second,
+                                                   no_third,
+                                                   no_fourth);
+        else
+          for (unsigned int i = 0; i < n_dofs; ++i)
+          {
+            point_values[i]    = fe.shape_value(i, points[q]);
+            point_gradients[i] = fe.shape_grad(i, points[q]);
+          }
         for (unsigned int i = 0; i < n_dofs; ++i)
         {
-          values[q * n_dofs + i]              = fe.shape_value(i, points[q]);
-          reference_gradients[q * n_dofs + i] = fe.shape_grad(i, points[q]);
+          values[q * n_dofs + i]              = point_values[i];
+          reference_gradients[q * n_dofs + i] = point_gradients[i];
         }
+      }
     }
     if (!with_gradients)
       return;
