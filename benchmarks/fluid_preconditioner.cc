@@ -134,8 +134,9 @@ run(const unsigned int level_min,
   const std::string drag_averaging = averaging != nullptr ? averaging : "jump";
   if (root)
     std::printf(
-      "| dim | level | DoFs | dt | beta h^2/mu | iterations | solve s | "
-      "s per MDoF | peak MiB |\n|---|---|---|---|---|---|---|---|---|\n");
+      "| dim | level | DoFs | dt | beta h^2/mu | iterations | step s | "
+      "s per MDoF | preconditioner s | FGMRES s | ms per iteration | peak MiB "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (unsigned int level = level_min; level <= level_max; ++level)
     for (const double dt : selected("FLUID_BENCH_DT", {1e-8, 1e-4, 1.0, 0.0}))
       for (const double beta_scaled :
@@ -200,6 +201,16 @@ run(const unsigned int level_min,
         const double seconds = std::chrono::duration<double>(
                                  std::chrono::steady_clock::now() - start)
                                  .count();
+        // The step's phases: assembly, the preconditioner's set-up, FGMRES.
+        const auto phases =
+          timer.get_summary_data(TimerOutput::OutputData::total_wall_time);
+        const auto phase = [&phases](const std::string &name)
+        {
+          const auto entry = phases.find(name);
+          return entry == phases.end() ? 0.0 : entry->second;
+        };
+        const double setup_seconds = phase("fluid: preconditioner");
+        const double solve_seconds = phase("fluid: solve");
         const double memory =
           Utilities::MPI::max(peak_memory_mib(), MPI_COMM_WORLD);
         if (root)
@@ -210,7 +221,8 @@ run(const unsigned int level_min,
           else
             std::snprintf(dt_text, sizeof(dt_text), "steady");
           std::printf(
-            "| %d | %u | %llu | %s | %g | %s | %.2f | %.2f | %.0f |\n",
+            "| %d | %u | %llu | %s | %g | %s | %.2f | %.2f | %.3f | %.3f | "
+            "%.2f | %.0f |\n",
             dim,
             level,
             static_cast<unsigned long long>(fluid.n_dofs()),
@@ -221,6 +233,9 @@ run(const unsigned int level_min,
               ("> " + std::to_string(parameters.max_linear_iterations)).c_str(),
             seconds,
             seconds / (fluid.n_dofs() * 1e-6),
+            setup_seconds,
+            solve_seconds,
+            1e3 * solve_seconds / std::max(1u, iterations),
             memory);
           std::fflush(stdout);
         }
