@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(libdeal.ii-dev numdiff ccache openmpi-bin cmake make g++ python3)
+packages=(libdeal.ii-dev numdiff ccache openmpi-bin cmake make g++ python3
+          python3-numpy python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

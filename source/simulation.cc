@@ -89,6 +89,7 @@ namespace ImmersedGrains
                    {"grains: free velocities", "grains: gather"}},
                   {"contacts", {"grains: contacts"}},
                   {"sort", {"grains: move and sort"}},
+                  {"adaptation", {"adaptation"}},
                   {"output", {"output"}},
                   {"statistics", {"statistics"}}};
       return phases;
@@ -191,6 +192,7 @@ namespace ImmersedGrains
     FluidParameters<dim>::declare_parameters(prm);
     Coupling<dim>::Parameters::declare_parameters(prm);
     GrainParameters<dim>::declare_parameters(prm);
+    Adaptivity<dim>::Parameters::declare_parameters(prm);
   }
 
 
@@ -273,8 +275,11 @@ namespace ImmersedGrains
     fluid_parameters.parse_parameters(prm, file, geometry);
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
+    adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
+    for (const auto &seed : grain_seeds)
+      largest_grain_radius = std::max(largest_grain_radius, seed.radius);
 
     // Stop here, before anything large is allocated or written, if the
     // scene cannot fit: the kernel would kill it half-way instead.
@@ -339,13 +344,7 @@ namespace ImmersedGrains
       dealii::TimerOutput::Scope scope(*timer, "mesh");
       geometry.create_mesh(triangulation);
     }
-    {
-      double h = std::numeric_limits<double>::max();
-      for (const auto &cell : triangulation.active_cell_iterators())
-        if (cell->is_locally_owned())
-          h = std::min(h, cell->minimum_vertex_distance());
-      shortest_cell_edge = dealii::Utilities::MPI::min(h, comm);
-    }
+    update_shortest_cell_edge();
     pcout << "immersed-grains: " << dim << "D scene " << parameter_file
           << " on " << dealii::Utilities::MPI::n_mpi_processes(comm)
           << " MPI rank(s)\n"
@@ -415,6 +414,80 @@ namespace ImmersedGrains
                   (coupling_parameters.two_way ? ", two-way" : ", one-way"))
             << '\n';
     }
+
+    if (adaptivity_parameters.enabled)
+    {
+      adaptivity =
+        std::make_unique<Adaptivity<dim>>(adaptivity_parameters,
+                                          triangulation,
+                                          adaptivity_parameters.min_cell_size *
+                                            2 * largest_grain_radius);
+      // Each pass refines a cell by one level at most: repeat until the
+      // mesh around the initial grains stops changing.
+      unsigned int passes = 0;
+      while (passes < 2 * (adaptivity_parameters.max_level + 1) && adapt_mesh())
+        ++passes;
+    }
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::update_shortest_cell_edge()
+  {
+    double h = std::numeric_limits<double>::max();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        h = std::min(h, cell->minimum_vertex_distance());
+    shortest_cell_edge = dealii::Utilities::MPI::min(h, comm);
+  }
+
+
+  template <int dim>
+  bool
+  Simulation<dim>::adapt_mesh()
+  {
+    const double start = now();
+    {
+      dealii::TimerOutput::Scope scope(*timer, "adaptation");
+      if (!adaptivity->mark_cells(grains ? &grains->particle_handler() :
+                                           nullptr,
+                                  fluid.get()))
+        return false;
+      if (fluid)
+        fluid->prepare_for_mesh_change();
+      if (grains)
+        grains->prepare_for_mesh_change();
+      triangulation.execute_coarsening_and_refinement();
+    }
+    if (fluid)
+      fluid->finish_mesh_change();
+    if (grains)
+      grains->finish_mesh_change();
+    if (coupling)
+    {
+      {
+        dealii::TimerOutput::Scope scope(*timer, "adaptation");
+        coupling->setup();
+      }
+      coupling->project(*grains);
+    }
+    update_shortest_cell_edge();
+    pcout << "  mesh adapted before step " << step + 1 << ": "
+          << triangulation.n_global_active_cells() << " cells, "
+          << (fluid ? fluid->n_dofs() : 0) << " fluid DoFs, "
+          << std::setprecision(3) << now() - start << " s\n"
+          << std::setprecision(6);
+    return true;
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::maybe_adapt_mesh()
+  {
+    if (adaptivity && step > 0 && adaptivity->due(step))
+      adapt_mesh();
   }
 
 
@@ -437,6 +510,7 @@ namespace ImmersedGrains
     {
       while (time < end_time * (1 - 1e-12))
       {
+        maybe_adapt_mesh();
         const double dt = next_time_step();
         ++step;
         solve_time_step(dt);

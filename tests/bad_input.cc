@@ -218,6 +218,16 @@ end
              "number = 0\n",
          "Courant number",
          "0"},
+        {"adaptivity_levels_reversed",
+         "set Dimension = 2\nsubsection Adaptivity\n set Enabled = true\n"
+             " set Min level = 4\n set Max level = 3\nend\n",
+         "Min level",
+         "4"},
+        {"adaptivity_without_fluid",
+         "set Dimension = 2\nsubsection Fluid\n set Enabled = false\nend\n"
+             "subsection Adaptivity\n set Enabled = true\nend\n",
+         "Enabled",
+         "true"},
   };
 
   unsigned int failures = 0;

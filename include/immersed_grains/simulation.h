@@ -13,6 +13,7 @@
 #include <immersed_grains/io/run_log.h>
 #include <immersed_grains/io/statistics.h>
 #include <immersed_grains/io/test_checks.h>
+#include <immersed_grains/mesh/adaptivity.h>
 #include <immersed_grains/mesh/geometry.h>
 #include <immersed_grains/mesh/size_estimate.h>
 
@@ -58,6 +59,14 @@ namespace ImmersedGrains
     prepare_output_directory();
     void
     setup();
+    // Refines and coarsens the mesh by the Adaptivity criteria and moves
+    // every state onto it; false if nothing changed.
+    bool
+    adapt_mesh();
+    void
+    maybe_adapt_mesh();
+    void
+    update_shortest_cell_edge();
     double
     next_time_step() const;
     void
@@ -98,10 +107,12 @@ namespace ImmersedGrains
     unsigned int                    clamped_nodes_before  = 0;
     unsigned int                    preconditioner_builds = 0;
 
-    Geometry<dim>                      geometry;
-    FluidParameters<dim>               fluid_parameters;
-    GrainParameters<dim>               grain_parameters;
-    typename Coupling<dim>::Parameters coupling_parameters;
+    Geometry<dim>                        geometry;
+    FluidParameters<dim>                 fluid_parameters;
+    GrainParameters<dim>                 grain_parameters;
+    typename Coupling<dim>::Parameters   coupling_parameters;
+    typename Adaptivity<dim>::Parameters adaptivity_parameters;
+    double                               largest_grain_radius = 0;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
     SizeEstimate                size_estimate;
@@ -119,6 +130,7 @@ namespace ImmersedGrains
     std::unique_ptr<Grains<dim>>                      grains;
     std::unique_ptr<ParticleOutput<dim>>              particle_output;
     std::unique_ptr<Coupling<dim>>                    coupling;
+    std::unique_ptr<Adaptivity<dim>>                  adaptivity;
 
     double       time = 0;
     unsigned int step = 0;

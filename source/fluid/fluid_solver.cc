@@ -249,6 +249,8 @@ namespace ImmersedGrains
   FluidSolver<dim>::setup_dofs()
   {
     dealii::TimerOutput::Scope scope(timer, "fluid: setup");
+    // The preconditioner refers to the matrices about to be rebuilt.
+    preconditioner.reset();
 
     dof_handler.distribute_dofs(fe);
     dealii::DoFRenumbering::Cuthill_McKee(dof_handler);
@@ -431,6 +433,47 @@ namespace ImmersedGrains
     const double mean = dealii::VectorTools::compute_mean_value(
       mapping, dof_handler, dealii::QGauss<dim>(3), ghosted, dim);
     vector.block(1).add(-mean);
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::prepare_for_mesh_change()
+  {
+    transfer = std::make_unique<
+      dealii::parallel::distributed::SolutionTransfer<dim, VectorType>>(
+      dof_handler);
+    transfer->prepare_for_coarsening_and_refinement(
+      std::vector<const VectorType *>{&solution,
+                                      &old_solution,
+                                      &old_old_solution});
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::finish_mesh_change()
+  {
+    Assert(transfer, dealii::ExcMessage("prepare_for_mesh_change() first"));
+    setup_dofs();
+    std::array<VectorType, 3> owned;
+    for (auto &v : owned)
+      v.reinit(owned_partitioning, mpi_communicator);
+    std::vector<VectorType *> targets = {&owned[0], &owned[1], &owned[2]};
+    transfer->interpolate(targets);
+    transfer.reset();
+    // Only the new hanging nodes: interpolation keeps the boundary values
+    // each state had at its own time.
+    dealii::IndexSet relevant;
+    dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+    dealii::AffineConstraints<double> hanging(relevant);
+    dealii::DoFTools::make_hanging_node_constraints(dof_handler, hanging);
+    hanging.close();
+    for (auto &v : owned)
+      hanging.distribute(v);
+    solution         = owned[0];
+    old_solution     = owned[1];
+    old_old_solution = owned[2];
   }
 
 

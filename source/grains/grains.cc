@@ -175,6 +175,24 @@ namespace ImmersedGrains
 
   template <int dim>
   void
+  Grains<dim>::prepare_for_mesh_change()
+  {
+    particles.prepare_for_coarsening_and_refinement();
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::finish_mesh_change()
+  {
+    dealii::TimerOutput::Scope scope(timer, "grains: setup");
+    particles.unpack_after_coarsening_and_refinement();
+    update_partition();
+  }
+
+
+  template <int dim>
+  void
   Grains<dim>::initialize(const std::vector<GrainSeed<dim>> &seeds)
   {
     dealii::TimerOutput::Scope scope(timer, "grains: setup");

@@ -5,6 +5,7 @@
 #include <deal.II/base/function.h>
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/timer.h>
+#include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
@@ -61,6 +62,17 @@ namespace ImmersedGrains
     /** Sets u from Fluid/Initial velocity, p = 0. */
     void
     set_initial_condition();
+
+    /** Before the triangulation changes: the solution and its BDF history
+     *  are attached to the cells (the triangulation's flags are final). */
+    void
+    prepare_for_mesh_change();
+
+    /** After it changed: DoFs, constraints and matrices anew, the three
+     *  states interpolated onto the new mesh; the step sizes and the step
+     *  count carry on, the preconditioner is rebuilt at the next solve. */
+    void
+    finish_mesh_change();
 
     void
     set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields);
@@ -247,6 +259,10 @@ namespace ImmersedGrains
 
     // DataOut keeps a pointer to the postprocessor until patches are built.
     mutable std::unique_ptr<dealii::DataPostprocessor<dim>> output_fields;
+
+    std::unique_ptr<
+      dealii::parallel::distributed::SolutionTransfer<dim, VectorType>>
+      transfer;
   };
 } // namespace ImmersedGrains
 

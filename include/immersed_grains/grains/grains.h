@@ -205,6 +205,16 @@ namespace ImmersedGrains
     const dealii::Particles::ParticleHandler<dim> &
     particle_handler() const;
 
+    /** Before the triangulation changes (its flags final): every grain
+     *  with all its properties is attached to its cell. */
+    void
+    prepare_for_mesh_change();
+
+    /** After it changed: the grains back in their (new) cells, the ranks'
+     *  boxes and the shortest cell edge anew (collective). */
+    void
+    finish_mesh_change();
+
     const GrainPropertyLayout &
     layout() const;
 

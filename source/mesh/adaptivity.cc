@@ -1,0 +1,312 @@
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/grid_refinement.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_dgq.h>
+#include <deal.II/fe/fe_values_extractors.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/lac/la_parallel_vector.h>
+#include <deal.II/numerics/error_estimator.h>
+
+#include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/mesh/adaptivity.h>
+#include <immersed_grains/parameters.h>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  void
+  Adaptivity<dim>::Parameters::declare_parameters(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii::Patterns;
+    prm.enter_subsection("Adaptivity");
+    {
+      prm.declare_entry("Enabled",
+                        "false",
+                        Bool(),
+                        "Refine the mesh around the grains (and where the "
+                        "criteria ask) and coarsen it elsewhere as they "
+                        "move.");
+      prm.declare_entry("Min level",
+                        "2",
+                        Integer(0, 12),
+                        "Coarsest refinement level of the coarse mesh "
+                        "(Mesh/Subdivisions) that cells are coarsened to.");
+      prm.declare_entry("Max level",
+                        "5",
+                        Integer(0, 12),
+                        "Finest refinement level, reached around the grains.");
+      prm.declare_entry("Every steps",
+                        "5",
+                        Integer(0),
+                        "Adapt the mesh before every this many fluid steps "
+                        "(0: only before the first). Between two adaptations "
+                        "the grains must stay inside the band: at the "
+                        "default Courant number 0.1 they cross half a finest "
+                        "cell in 5 steps, and the band is 2 cells wide.");
+      prm.declare_entry(
+        "Criteria",
+        "grains",
+        MultipleSelection("grains|velocity"),
+        "grains: every cell holding a grain and Band width layers of cells "
+        "around it at Max level, the rest coarsened towards Min level. "
+        "velocity: the Kelly estimator of the fluid velocity refines "
+        "Refine fraction and coarsens Coarsen fraction of the cells (by "
+        "number) between the two levels, for wakes.");
+      prm.declare_entry("Band width",
+                        "2",
+                        Integer(0, 20),
+                        "Layers of cells (sharing a vertex) around the cells "
+                        "that hold grains that are refined with them.");
+      prm.declare_entry("Refine fraction",
+                        "0.1",
+                        Double(0, 1),
+                        "Criteria = velocity: the share of cells refined.");
+      prm.declare_entry("Coarsen fraction",
+                        "0.3",
+                        Double(0, 1),
+                        "Criteria = velocity: the share of cells coarsened.");
+      prm.declare_entry(
+        "Minimum cell size",
+        "2",
+        Double(0),
+        "No cell is refined into children smaller than this many diameters "
+        "of the largest grain: the drag closures hold for a grain inside a "
+        "cell larger than itself (the cell is the averaging volume), and "
+        "were validated from 2 diameters up (doc/theory.md).");
+    }
+    prm.leave_subsection();
+  }
+
+
+  template <int dim>
+  void
+  Adaptivity<dim>::Parameters::parse_parameters(dealii::ParameterHandler &prm,
+                                                const std::string        &file,
+                                                const bool fluid_enabled)
+  {
+    const InputLocation where{file, "Adaptivity"};
+    prm.enter_subsection("Adaptivity");
+    {
+      enabled     = prm.get_bool("Enabled");
+      min_level   = prm.get_integer("Min level");
+      max_level   = prm.get_integer("Max level");
+      every_steps = prm.get_integer("Every steps");
+      const auto criteria =
+        dealii::Utilities::split_string_list(prm.get("Criteria"));
+      around_grains =
+        std::find(criteria.begin(), criteria.end(), "grains") != criteria.end();
+      velocity_kelly =
+        std::find(criteria.begin(), criteria.end(), "velocity") !=
+        criteria.end();
+      band_width       = prm.get_integer("Band width");
+      refine_fraction  = prm.get_double("Refine fraction");
+      coarsen_fraction = prm.get_double("Coarsen fraction");
+      min_cell_size    = prm.get_double("Minimum cell size");
+      if (enabled)
+      {
+        where.require(min_level <= max_level,
+                      "Min level",
+                      prm.get("Min level"),
+                      "is above Max level (" + prm.get("Max level") + ")");
+        where.require(fluid_enabled,
+                      "Enabled",
+                      prm.get("Enabled"),
+                      "needs a fluid (Fluid/Enabled = true): the mesh only "
+                      "carries the fluid and the coupling");
+        where.require(refine_fraction + coarsen_fraction <= 1,
+                      "Refine fraction",
+                      prm.get("Refine fraction"),
+                      "plus Coarsen fraction (" + prm.get("Coarsen fraction") +
+                        ") exceeds 1");
+      }
+    }
+    prm.leave_subsection();
+  }
+
+
+  template <int dim>
+  Adaptivity<dim>::Adaptivity(
+    const Parameters                                  &parameters,
+    dealii::parallel::distributed::Triangulation<dim> &tria,
+    const double                                       smallest_cell)
+      : parameters(parameters)
+      , triangulation(tria)
+      , smallest_cell(smallest_cell)
+  {
+  }
+
+
+  template <int dim>
+  std::vector<bool>
+  Adaptivity<dim>::grain_band(
+    const dealii::Particles::ParticleHandler<dim> &grains) const
+  {
+    // One value per cell with ghosts: a DG0 field.
+    dealii::DoFHandler<dim>   cells(triangulation);
+    const dealii::FE_DGQ<dim> fe(0);
+    cells.distribute_dofs(fe);
+    dealii::IndexSet relevant;
+    dealii::DoFTools::extract_locally_relevant_dofs(cells, relevant);
+    dealii::LinearAlgebra::distributed::Vector<double> marked(
+      cells.locally_owned_dofs(), relevant, triangulation.get_communicator());
+
+    std::vector<dealii::types::global_dof_index> index(1);
+    for (const auto &cell : cells.active_cell_iterators())
+      if (cell->is_locally_owned() && grains.n_particles_in_cell(cell) > 0)
+      {
+        cell->get_dof_indices(index);
+        marked[index[0]] = 1;
+      }
+
+    const auto vertex_cells = dealii::GridTools::vertex_to_cell_map(
+      static_cast<const dealii::Triangulation<dim> &>(triangulation));
+    for (unsigned int layer = 0; layer < parameters.band_width; ++layer)
+    {
+      marked.update_ghost_values();
+      std::vector<dealii::types::global_dof_index> grow;
+      for (const auto &cell : cells.active_cell_iterators())
+      {
+        if (!cell->is_locally_owned())
+          continue;
+        cell->get_dof_indices(index);
+        if (marked[index[0]] != 0)
+          continue;
+        bool near = false;
+        for (const unsigned int v : cell->vertex_indices())
+        {
+          for (const auto &other : vertex_cells[cell->vertex_index(v)])
+            if (!other->is_artificial())
+            {
+              std::vector<dealii::types::global_dof_index> o(1);
+              typename dealii::DoFHandler<dim>::active_cell_iterator(
+                &triangulation, other->level(), other->index(), &cells)
+                ->get_dof_indices(o);
+              if (marked[o[0]] != 0)
+              {
+                near = true;
+                break;
+              }
+            }
+          if (near)
+            break;
+        }
+        if (near)
+          grow.push_back(index[0]);
+      }
+      marked.zero_out_ghost_values();
+      for (const auto i : grow)
+        marked[i] = 1;
+    }
+
+    std::vector<bool> band(triangulation.n_active_cells(), false);
+    for (const auto &cell : cells.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        cell->get_dof_indices(index);
+        band[cell->active_cell_index()] = marked[index[0]] != 0;
+      }
+    return band;
+  }
+
+
+  template <int dim>
+  bool
+  Adaptivity<dim>::mark_cells(
+    const dealii::Particles::ParticleHandler<dim> *grains,
+    const FluidSolver<dim>                        *fluid)
+  {
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        cell->clear_refine_flag();
+        cell->clear_coarsen_flag();
+      }
+
+    if (parameters.velocity_kelly && fluid != nullptr)
+    {
+      dealii::Vector<float> indicators(triangulation.n_active_cells());
+      const dealii::FEValuesExtractors::Vector velocities(0);
+      dealii::KellyErrorEstimator<dim>::estimate(
+        fluid->get_dof_handler(),
+        dealii::QGauss<dim - 1>(3),
+        std::map<dealii::types::boundary_id, const dealii::Function<dim> *>(),
+        fluid->get_solution(),
+        indicators,
+        fluid->get_dof_handler().get_fe().component_mask(velocities),
+        nullptr,
+        dealii::numbers::invalid_unsigned_int,
+        triangulation.locally_owned_subdomain());
+      dealii::parallel::distributed::GridRefinement::
+        refine_and_coarsen_fixed_number(triangulation,
+                                        indicators,
+                                        parameters.refine_fraction,
+                                        parameters.coarsen_fraction);
+    }
+
+    std::vector<bool> band;
+    if (parameters.around_grains && grains != nullptr)
+      band = grain_band(*grains);
+
+    for (const auto &cell : triangulation.active_cell_iterators())
+    {
+      if (!cell->is_locally_owned())
+        continue;
+      const unsigned int level = cell->level();
+      const bool in_band = !band.empty() && band[cell->active_cell_index()];
+      if (in_band)
+      {
+        cell->clear_coarsen_flag();
+        cell->set_refine_flag();
+      }
+      else if (!parameters.velocity_kelly)
+        cell->set_coarsen_flag();
+      // The levels and the cell-size floor overrule the criteria.
+      if (level >= parameters.max_level ||
+          cell->minimum_vertex_distance() < 2 * smallest_cell)
+        cell->clear_refine_flag();
+      if (level <= parameters.min_level)
+        cell->clear_coarsen_flag();
+      if (level < parameters.min_level)
+        cell->set_refine_flag();
+      if (level > parameters.max_level)
+      {
+        cell->clear_refine_flag();
+        cell->set_coarsen_flag();
+      }
+      if (in_band && cell->coarsen_flag_set() && level <= parameters.max_level)
+        cell->clear_coarsen_flag();
+    }
+
+    bool any = false;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned() &&
+          (cell->refine_flag_set() || cell->coarsen_flag_set()))
+      {
+        // A coarsen flag only counts if all siblings carry one; the
+        // triangulation decides that in prepare_coarsening_and_refinement.
+        any = true;
+        break;
+      }
+    if (!dealii::Utilities::MPI::logical_or(any,
+                                            triangulation.get_communicator()))
+      return false;
+    const auto before = triangulation.n_global_active_cells();
+    (void)before;
+    triangulation.prepare_coarsening_and_refinement();
+    bool changes = false;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned() &&
+          (cell->refine_flag_set() || cell->coarsen_flag_set()))
+      {
+        changes = true;
+        break;
+      }
+    return dealii::Utilities::MPI::logical_or(changes,
+                                              triangulation.get_communicator());
+  }
+
+
+  template class Adaptivity<2>;
+  template class Adaptivity<3>;
+} // namespace ImmersedGrains
