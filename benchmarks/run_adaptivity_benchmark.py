@@ -13,35 +13,16 @@ Usage (after scripts/setup.sh):
         [--scenes cloud_2d_adaptive] [--ranks N] [--out DIR]
 """
 import argparse
-import csv
 import os
 import re
-import subprocess
-import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import scene_runner  # noqa: E402 (beside this script)
 
-
-def read_csv(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
+ROOT = scene_runner.ROOT
 
 
 def run(prm_text, directory, ranks):
-    with tempfile.NamedTemporaryFile("w", suffix=".prm", delete=False) as prm:
-        prm.write(prm_text)
-        prm.write("\nset Output directory = %s\n" % directory)
-        prm.write("subsection Output\n  set Terminal output = quiet\nend\n")
-    command = [os.path.join(ROOT, "build", "immersed-grains"), prm.name]
-    if ranks > 1:
-        command = ["mpirun", "-np", str(ranks)] + command
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1",
-               OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1",
-               DEAL_II_NUM_THREADS="1", OMP_NUM_THREADS="1")
-    subprocess.run(command, check=True, env=env)
-    os.unlink(prm.name)
-    rows = read_csv(os.path.join(directory, "statistics.csv"))
+    rows = scene_runner.run_scene(prm_text, directory, ranks)
     return {"time": [float(r["time"]) for r in rows],
             "y": [float(r["centroid_y"]) for r in rows],
             "cells": [int(float(r["cells"])) for r in rows],

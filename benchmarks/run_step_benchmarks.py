@@ -13,42 +13,23 @@ Usage (after scripts/setup.sh):
         [--ranks N] [--save FILE] [--compare FILE] [--out DIR]
 """
 import argparse
-import csv
 import json
 import os
-import subprocess
 import sys
-import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import scene_runner  # noqa: E402 (beside this script)
+
+ROOT = scene_runner.ROOT
 PHASES = ["assembly", "preconditioner", "solve", "solid_fraction",
           "interaction_force", "grain_velocities", "contacts", "sort",
           "statistics", "output", "other"]
 
 
-def read_csv(path):
-    with open(path) as f:
-        return list(csv.DictReader(f))
-
-
 def run_scene(name, ranks, out):
     scene = os.path.join(ROOT, "benchmarks", "step", name + ".prm")
     directory = os.path.join(out, name)
-    with tempfile.NamedTemporaryFile("w", suffix=".prm", delete=False) as prm:
-        prm.write(open(scene).read())
-        prm.write("\nset Output directory = %s\n" % directory)
-        prm.write("subsection Output\n  set Terminal output = quiet\nend\n")
-    command = [os.path.join(ROOT, "build", "immersed-grains"), prm.name]
-    if ranks > 1:
-        command = ["mpirun", "-np", str(ranks)] + command
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1",
-               OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1",
-               DEAL_II_NUM_THREADS="1", OMP_NUM_THREADS="1")
-    subprocess.run(command, check=True, env=env)
-    os.unlink(prm.name)
-    timings = read_csv(os.path.join(directory, "timings.csv"))[1:]
-    stats = read_csv(os.path.join(directory, "statistics.csv"))[1:]
+    stats = scene_runner.run_scene(open(scene).read(), directory, ranks)[1:]
+    timings = scene_runner.read_csv(os.path.join(directory, "timings.csv"))[1:]
     steps = len(timings)
     result = {"steps": steps,
               "cells": int(float(stats[-1]["cells"])),

@@ -71,6 +71,9 @@ namespace ImmersedGrains
         c.push_back(std::string("fixed_centroid_") + axes[d]);
       c.emplace_back("drag_averaged_cells");
       c.emplace_back("preconditioner_builds"); // cumulative
+      // Most loaded rank over the mean, cells and grains weighted as for
+      // partitioning (1 on one rank or without grains).
+      c.emplace_back("load_imbalance");
       return c;
     }
 
@@ -193,6 +196,7 @@ namespace ImmersedGrains
     Coupling<dim>::Parameters::declare_parameters(prm);
     GrainParameters<dim>::declare_parameters(prm);
     Adaptivity<dim>::Parameters::declare_parameters(prm);
+    LoadBalance<dim>::Parameters::declare_parameters(prm);
   }
 
 
@@ -276,6 +280,7 @@ namespace ImmersedGrains
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);
+    load_balance_parameters.parse_parameters(prm, file);
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
     for (const auto &seed : grain_seeds)
@@ -415,6 +420,14 @@ namespace ImmersedGrains
             << '\n';
     }
 
+    // Grains make cells unequal work; on one rank there is nothing to
+    // balance.
+    if (fluid && grains && load_balance_parameters.grain_weight > 0 &&
+        dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
+      load_balance =
+        std::make_unique<LoadBalance<dim>>(load_balance_parameters,
+                                           triangulation,
+                                           grains->particle_handler());
     if (adaptivity_parameters.enabled)
     {
       adaptivity =
@@ -428,6 +441,7 @@ namespace ImmersedGrains
       while (passes < 2 * (adaptivity_parameters.max_level + 1) && adapt_mesh())
         ++passes;
     }
+    maybe_adapt_mesh();
   }
 
 
@@ -454,11 +468,31 @@ namespace ImmersedGrains
                                            nullptr,
                                   fluid.get()))
         return false;
+    }
+    change_mesh([this]()
+                { triangulation.execute_coarsening_and_refinement(); });
+    pcout << "  mesh adapted before step " << step + 1 << ": "
+          << triangulation.n_global_active_cells() << " cells, "
+          << (fluid ? fluid->n_dofs() : 0) << " fluid DoFs, "
+          << std::setprecision(3) << now() - start << " s";
+    if (load_balance)
+      pcout << ", load imbalance " << load_balance->imbalance();
+    pcout << '\n' << std::setprecision(6);
+    return true;
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::change_mesh(const std::function<void()> &change)
+  {
+    {
+      dealii::TimerOutput::Scope scope(*timer, "adaptation");
       if (fluid)
         fluid->prepare_for_mesh_change();
       if (grains)
         grains->prepare_for_mesh_change();
-      triangulation.execute_coarsening_and_refinement();
+      change();
     }
     if (fluid)
       fluid->finish_mesh_change();
@@ -473,12 +507,6 @@ namespace ImmersedGrains
       coupling->project(*grains);
     }
     update_shortest_cell_edge();
-    pcout << "  mesh adapted before step " << step + 1 << ": "
-          << triangulation.n_global_active_cells() << " cells, "
-          << (fluid ? fluid->n_dofs() : 0) << " fluid DoFs, "
-          << std::setprecision(3) << now() - start << " s\n"
-          << std::setprecision(6);
-    return true;
   }
 
 
@@ -486,8 +514,19 @@ namespace ImmersedGrains
   void
   Simulation<dim>::maybe_adapt_mesh()
   {
-    if (adaptivity && step > 0 && adaptivity->due(step))
-      adapt_mesh();
+    if (adaptivity && step > 0 && adaptivity->due(step) && adapt_mesh())
+      return;
+    if (!load_balance)
+      return;
+    // Collective: every rank computes the same global figure.
+    const double before = load_balance->imbalance();
+    if (before <= load_balance_parameters.max_imbalance)
+      return;
+    change_mesh([this]() { triangulation.repartition(); });
+    pcout << "  mesh repartitioned before step " << step + 1
+          << ": load imbalance " << std::setprecision(3) << before << " -> "
+          << load_balance->imbalance() << '\n'
+          << std::setprecision(6);
   }
 
 
@@ -713,6 +752,8 @@ namespace ImmersedGrains
     statistics.set("time", time);
     statistics.set("dt", dt);
     statistics.set("cells", triangulation.n_global_active_cells());
+    statistics.set("load_imbalance",
+                   load_balance ? load_balance->imbalance() : 1.0);
     statistics.set("fluid_iterations", fluid_iterations);
     if (fluid)
     {

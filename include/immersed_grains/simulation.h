@@ -15,8 +15,10 @@
 #include <immersed_grains/io/test_checks.h>
 #include <immersed_grains/mesh/adaptivity.h>
 #include <immersed_grains/mesh/geometry.h>
+#include <immersed_grains/mesh/load_balance.h>
 #include <immersed_grains/mesh/size_estimate.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -63,6 +65,12 @@ namespace ImmersedGrains
     // every state onto it; false if nothing changed.
     bool
     adapt_mesh();
+    // Moves every state across @p change of the mesh (refinement or
+    // repartitioning).
+    void
+    change_mesh(const std::function<void()> &change);
+    // Adapts the mesh when due, else repartitions it when the ranks' loads
+    // are uneven.
     void
     maybe_adapt_mesh();
     void
@@ -107,12 +115,13 @@ namespace ImmersedGrains
     unsigned int                    clamped_nodes_before  = 0;
     unsigned int                    preconditioner_builds = 0;
 
-    Geometry<dim>                        geometry;
-    FluidParameters<dim>                 fluid_parameters;
-    GrainParameters<dim>                 grain_parameters;
-    typename Coupling<dim>::Parameters   coupling_parameters;
-    typename Adaptivity<dim>::Parameters adaptivity_parameters;
-    double                               largest_grain_radius = 0;
+    Geometry<dim>                         geometry;
+    FluidParameters<dim>                  fluid_parameters;
+    GrainParameters<dim>                  grain_parameters;
+    typename Coupling<dim>::Parameters    coupling_parameters;
+    typename Adaptivity<dim>::Parameters  adaptivity_parameters;
+    typename LoadBalance<dim>::Parameters load_balance_parameters;
+    double                                largest_grain_radius = 0;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
     SizeEstimate                size_estimate;
@@ -131,6 +140,7 @@ namespace ImmersedGrains
     std::unique_ptr<ParticleOutput<dim>>              particle_output;
     std::unique_ptr<Coupling<dim>>                    coupling;
     std::unique_ptr<Adaptivity<dim>>                  adaptivity;
+    std::unique_ptr<LoadBalance<dim>>                 load_balance;
 
     double       time = 0;
     unsigned int step = 0;
