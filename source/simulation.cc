@@ -197,6 +197,7 @@ namespace ImmersedGrains
     GrainParameters<dim>::declare_parameters(prm);
     Adaptivity<dim>::Parameters::declare_parameters(prm);
     LoadBalance<dim>::Parameters::declare_parameters(prm);
+    Checkpoint::Parameters::declare_parameters(prm);
   }
 
 
@@ -281,6 +282,7 @@ namespace ImmersedGrains
     coupling_parameters.parse_parameters(prm, file);
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);
     load_balance_parameters.parse_parameters(prm, file);
+    checkpoint_parameters.parse_parameters(prm, file);
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
     for (const auto &seed : grain_seeds)
@@ -314,7 +316,7 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  Simulation<dim>::prepare_output_directory()
+  Simulation<dim>::prepare_output_directory(const int resumed_step)
   {
     const bool root = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
     if (root)
@@ -332,9 +334,9 @@ namespace ImmersedGrains
         std::filesystem::copy_options::overwrite_existing);
     }
     MPI_Barrier(comm);
-    log.open(output_directory + "/log.txt", root, !quiet);
-    statistics.open(output_directory + "/statistics.csv", root);
-    timings.open(output_directory + "/timings.csv", root);
+    log.open(output_directory + "/log.txt", root, !quiet, resumed_step >= 0);
+    statistics.open(output_directory + "/statistics.csv", root, resumed_step);
+    timings.open(output_directory + "/timings.csv", root, resumed_step);
     field_output = std::make_unique<FieldOutput<dim>>(output_directory, comm);
     particle_output =
       std::make_unique<ParticleOutput<dim>>(output_directory, comm);
@@ -343,17 +345,26 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  Simulation<dim>::setup()
+  Simulation<dim>::setup(const std::string &resume_from)
   {
+    const bool resumed = !resume_from.empty();
     {
       dealii::TimerOutput::Scope scope(*timer, "mesh");
-      geometry.create_mesh(triangulation);
+      if (resumed)
+      {
+        geometry.create_coarse_mesh(triangulation);
+        triangulation.load(resume_from + "/mesh");
+      }
+      else
+        geometry.create_mesh(triangulation);
     }
     update_shortest_cell_edge();
     pcout << "immersed-grains: " << dim << "D scene " << parameter_file
           << " on " << dealii::Utilities::MPI::n_mpi_processes(comm)
-          << " MPI rank(s)\n"
-          << "  mesh: " << triangulation.n_global_active_cells()
+          << " MPI rank(s)\n";
+    if (resumed)
+      pcout << "  resumed from " << resume_from << '\n';
+    pcout << "  mesh: " << triangulation.n_global_active_cells()
           << " cells, boundary conditions:";
     for (const auto t : geometry.boundary_types)
       pcout << ' ' << to_string(t);
@@ -369,7 +380,10 @@ namespace ImmersedGrains
       fluid = std::make_unique<FluidSolver<dim>>(
         fluid_parameters, geometry, triangulation, *timer, pcout);
       fluid->setup_dofs();
-      fluid->set_initial_condition();
+      if (resumed)
+        fluid->deserialize();
+      else
+        fluid->set_initial_condition();
       pcout << "  fluid: "
             << (fluid_parameters.advection ? "Navier-Stokes" : "Stokes")
             << (fluid_parameters.time_derivative ?
@@ -388,10 +402,14 @@ namespace ImmersedGrains
                                              triangulation,
                                              fluid_parameters.enabled,
                                              *timer);
-      grains->initialize(grain_seeds);
+      // A resumed run does not place its grains again.
+      if (resumed)
+        grains->deserialize();
+      else
+        grains->initialize(grain_seeds);
       const auto &c = grain_parameters.contact;
-      pcout << "  grains: " << grain_seeds.size() << ", "
-            << grains->layout().n_properties << " properties per grain";
+      pcout << "  grains: " << grains->particle_handler().n_global_particles()
+            << ", " << grains->layout().n_properties << " properties per grain";
       if (grain_parameters.contacts_enabled)
         pcout << "; contacts: e = " << c.restitution << ", mu = " << c.friction
               << ", tolerance " << c.tolerance;
@@ -438,10 +456,14 @@ namespace ImmersedGrains
       // Each pass refines a cell by one level at most: repeat until the
       // mesh around the initial grains stops changing.
       unsigned int passes = 0;
-      while (passes < 2 * (adaptivity_parameters.max_level + 1) && adapt_mesh())
+      while (!resumed && passes < 2 * (adaptivity_parameters.max_level + 1) &&
+             adapt_mesh())
         ++passes;
     }
-    maybe_adapt_mesh();
+    if (resumed)
+      load_state(resume_from);
+    else
+      maybe_adapt_mesh();
   }
 
 
@@ -532,16 +554,177 @@ namespace ImmersedGrains
 
   template <int dim>
   void
+  Simulation<dim>::maybe_write_checkpoint()
+  {
+    if (checkpoint->due(step, now()))
+      write_checkpoint();
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::write_checkpoint()
+  {
+    dealii::TimerOutput::Scope scope(*timer, "output");
+    const std::string          directory = checkpoint->begin(step);
+    // The fluid's states first, then the grains: loading follows this
+    // order.
+    if (fluid)
+      fluid->prepare_for_serialization();
+    if (grains)
+      grains->prepare_for_serialization();
+    triangulation.save(directory + "/mesh");
+    if (grains)
+    {
+      std::ofstream out(
+        directory + "/contacts_" +
+        std::to_string(dealii::Utilities::MPI::this_mpi_process(comm)) +
+        ".txt");
+      grains->save_contact_memory(out);
+      AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
+    }
+    // Written last: its presence marks the set complete (Checkpoint).
+    save_state(directory);
+    const std::string saved = checkpoint->commit(step, now());
+
+    // Go on from what was just written, as a run resumed from it would: a
+    // loaded triangulation numbers its cells afresh, and with them the
+    // DoFs and the order of the grains, while one that was refined and
+    // coarsened keeps the gaps of its history; the two would round
+    // differently from here on. (The preconditioner is rebuilt too.)
+    const bool echo = pcout.is_active();
+    pcout.set_condition(false);
+    coupling.reset();
+    adaptivity.reset();
+    load_balance.reset();
+    grains.reset();
+    fluid.reset();
+    triangulation.clear();
+    setup(saved);
+    pcout.set_condition(echo);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::save_state(const std::string &directory) const
+  {
+    MPI_Barrier(comm);
+    if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    std::ofstream out(directory + "/state.txt.part");
+    out << step << '\n'
+        << std::hexfloat << time << '\n'
+        << std::dec << dealii::Utilities::MPI::n_mpi_processes(comm) << ' '
+        << clamped_nodes_before << ' ' << preconditioner_builds << '\n';
+    if (fluid)
+      fluid->save_state(out);
+    else
+      out << "none\n";
+    for (const auto *records :
+         {&field_output->pvd_records(), &particle_output->pvd_records()})
+    {
+      out << records->size() << '\n';
+      for (const auto &[t, file] : *records)
+        out << std::hexfloat << t << ' ' << file << '\n';
+    }
+    statistics.save_values(out);
+    out.close();
+    AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
+    std::filesystem::rename(directory + "/state.txt.part",
+                            directory + "/state.txt");
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::load_state(const std::string &directory)
+  {
+    // Every rank reads the same file.
+    std::ifstream in(directory + "/state.txt");
+    std::string   text;
+    unsigned int  saved_ranks = 0;
+    in >> step >> text >> saved_ranks >> clamped_nodes_before >>
+      preconditioner_builds;
+    time = std::strtod(text.c_str(), nullptr);
+    if (fluid)
+      fluid->load_state(in);
+    else
+      in >> text;
+    for (auto *records :
+         {&field_output->pvd_records(), &particle_output->pvd_records()})
+    {
+      std::size_t n = 0;
+      in >> n;
+      records->clear();
+      for (std::size_t k = 0; k < n; ++k)
+      {
+        std::string file;
+        in >> text >> file;
+        records->emplace_back(std::strtod(text.c_str(), nullptr), file);
+      }
+    }
+    statistics.load_values(in);
+    AssertThrow(!in.bad(),
+                dealii::ExcMessage("Checkpoint: cannot read " + directory));
+
+    if (grains)
+    {
+      // The same ranks: each its own warm-start impulses, exactly as it
+      // left them. Others: every rank all of them (it uses those of its
+      // contacts).
+      const unsigned int n_ranks =
+        dealii::Utilities::MPI::n_mpi_processes(comm);
+      const unsigned int me = dealii::Utilities::MPI::this_mpi_process(comm);
+      for (unsigned int r = 0; r < saved_ranks; ++r)
+        if (saved_ranks != n_ranks || r == me)
+        {
+          std::ifstream contacts(directory + "/contacts_" + std::to_string(r) +
+                                 ".txt");
+          grains->load_contact_memory(contacts);
+        }
+    }
+  }
+
+
+  template <int dim>
+  void
   Simulation<dim>::run()
   {
+    checkpoint = std::make_unique<Checkpoint>(checkpoint_parameters,
+                                              output_directory,
+                                              comm);
+    const std::string resume_from =
+      checkpoint_parameters.resume == Checkpoint::Resume::never ?
+        std::string() :
+        checkpoint->newest();
+    if (checkpoint_parameters.resume == Checkpoint::Resume::always &&
+        resume_from.empty())
+      InputLocation{parameter_file, "Checkpoint"}.fail(
+        "Resume",
+        "true",
+        "no complete checkpoint in " + output_directory + "/checkpoints");
+    int resumed_step = -1;
+    if (!resume_from.empty())
+    {
+      std::ifstream state(resume_from + "/state.txt");
+      state >> resumed_step;
+      AssertThrow(state && resumed_step >= 0,
+                  dealii::ExcMessage("Checkpoint: cannot read " + resume_from +
+                                     "/state.txt"));
+    }
+
     // Created only now: a TimerOutput alive while a parse error unwinds
     // would print its own complaint beside the one-line message.
     timer = std::make_unique<dealii::TimerOutput>(
       comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times);
-    prepare_output_directory();
-    setup();
-    postprocess(0, 0);
-    maybe_write_fields(true);
+    prepare_output_directory(resumed_step);
+    setup(resume_from);
+    if (resume_from.empty())
+    {
+      postprocess(0, 0);
+      maybe_write_fields(true);
+    }
     record_timings();
 
     // Steps end exactly on End time; a last short step is allowed.
@@ -555,6 +738,7 @@ namespace ImmersedGrains
         solve_time_step(dt);
         maybe_write_fields(time >= end_time * (1 - 1e-12));
         record_timings();
+        maybe_write_checkpoint();
       }
     }
     catch (...)

@@ -223,6 +223,10 @@ end
              " set Min level = 4\n set Max level = 3\nend\n",
          "Min level",
          "4"},
+        {"resume_without_checkpoint",
+         "set Dimension = 2\nsubsection Checkpoint\n set Resume = true\nend\n",
+         "Resume",
+         "true"},
         {"adaptivity_without_fluid",
          "set Dimension = 2\nsubsection Fluid\n set Enabled = false\nend\n"
              "subsection Adaptivity\n set Enabled = true\nend\n",

@@ -10,6 +10,7 @@
 #include <immersed_grains/fluid/fluid_parameters.h>
 #include <immersed_grains/grains/grain_parameters.h>
 #include <immersed_grains/grains/placement.h>
+#include <immersed_grains/io/checkpoint.h>
 #include <immersed_grains/io/run_log.h>
 #include <immersed_grains/io/statistics.h>
 #include <immersed_grains/io/test_checks.h>
@@ -57,10 +58,23 @@ namespace ImmersedGrains
     run();
 
   private:
+    // With @p resumed_step >= 0 the files of the run being resumed are
+    // kept up to that step and appended to.
     void
-    prepare_output_directory();
+    prepare_output_directory(int resumed_step);
+    // From the parameters, or (@p resume_from a checkpoint directory) from
+    // a saved state.
     void
-    setup();
+    setup(const std::string &resume_from);
+    void
+    maybe_write_checkpoint();
+    void
+    write_checkpoint();
+    // Time, step, counters, statistics and output records (rank 0 writes).
+    void
+    save_state(const std::string &directory) const;
+    void
+    load_state(const std::string &directory);
     // Refines and coarsens the mesh by the Adaptivity criteria and moves
     // every state onto it; false if nothing changed.
     bool
@@ -121,6 +135,7 @@ namespace ImmersedGrains
     typename Coupling<dim>::Parameters    coupling_parameters;
     typename Adaptivity<dim>::Parameters  adaptivity_parameters;
     typename LoadBalance<dim>::Parameters load_balance_parameters;
+    Checkpoint::Parameters                checkpoint_parameters;
     double                                largest_grain_radius = 0;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
@@ -141,6 +156,7 @@ namespace ImmersedGrains
     std::unique_ptr<Coupling<dim>>                    coupling;
     std::unique_ptr<Adaptivity<dim>>                  adaptivity;
     std::unique_ptr<LoadBalance<dim>>                 load_balance;
+    std::unique_ptr<Checkpoint>                       checkpoint;
 
     double       time = 0;
     unsigned int step = 0;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <sstream>
+#include <string>
 
 // The scheme (Moreau 1988, "Unilateral contact and dry friction in finite
 // freedom dynamics", CISM Courses 302; Jean 1999, "The non-smooth contact
@@ -452,6 +454,54 @@ namespace ImmersedGrains
         row_of_input[keyed_rows[q].second] = q;
     }
 
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::save_warm_start(std::ostream &out) const
+    {
+      out << std::hexfloat;
+      for (const CachedImpulse &c : cache)
+      {
+        out << c.key.first << ' ' << c.key.second << ' ' << c.p_n;
+        for (unsigned int d = 0; d < dim; ++d)
+          out << ' ' << c.p_t[d];
+        out << '\n';
+      }
+      out << std::defaultfloat;
+    }
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::load_warm_start(std::istream &in)
+    {
+      // (operator>> does not read hexadecimal floating point.)
+      std::string line;
+      while (std::getline(in, line))
+      {
+        std::istringstream fields(line);
+        CachedImpulse      c;
+        std::string        value;
+        if (!(fields >> c.key.first >> c.key.second >> value))
+          continue;
+        c.p_n = std::strtod(value.c_str(), nullptr);
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          fields >> value;
+          c.p_t[d] = std::strtod(value.c_str(), nullptr);
+        }
+        cache.push_back(c);
+      }
+      const auto by_key = [](const CachedImpulse &a, const CachedImpulse &b)
+      { return a.key < b.key; };
+      std::stable_sort(cache.begin(), cache.end(), by_key);
+      cache.erase(std::unique(cache.begin(),
+                              cache.end(),
+                              [](const CachedImpulse &a, const CachedImpulse &b)
+                              { return a.key == b.key; }),
+                  cache.end());
+    }
 
 
     template <int dim>

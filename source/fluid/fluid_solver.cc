@@ -478,6 +478,57 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  void
+  FluidSolver<dim>::prepare_for_serialization()
+  {
+    // Kept until the triangulation is saved: it refers to this object.
+    transfer = std::make_unique<
+      dealii::parallel::distributed::SolutionTransfer<dim, VectorType>>(
+      dof_handler);
+    transfer->prepare_for_serialization(std::vector<const VectorType *>{
+      &solution, &old_solution, &old_old_solution});
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::deserialize()
+  {
+    std::array<VectorType, 3> owned;
+    for (auto &v : owned)
+      v.reinit(owned_partitioning, mpi_communicator);
+    std::vector<VectorType *> targets = {&owned[0], &owned[1], &owned[2]};
+    dealii::parallel::distributed::SolutionTransfer<dim, VectorType> loader(
+      dof_handler);
+    loader.deserialize(targets);
+    solution         = owned[0];
+    old_solution     = owned[1];
+    old_old_solution = owned[2];
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::save_state(std::ostream &out) const
+  {
+    out << std::hexfloat << time << ' ' << dt << ' ' << old_dt << ' '
+        << std::dec << steps_done << '\n';
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::load_state(std::istream &in)
+  {
+    std::string t, d, o;
+    in >> t >> d >> o >> steps_done;
+    time   = std::strtod(t.c_str(), nullptr);
+    dt     = std::strtod(d.c_str(), nullptr);
+    old_dt = std::strtod(o.c_str(), nullptr);
+  }
+
+
+  template <int dim>
   typename FluidSolver<dim>::StepStatistics
   FluidSolver<dim>::solve_time_step(const double new_time, const double step)
   {

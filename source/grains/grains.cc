@@ -193,6 +193,43 @@ namespace ImmersedGrains
 
   template <int dim>
   void
+  Grains<dim>::prepare_for_serialization()
+  {
+    particles.prepare_for_serialization();
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::deserialize()
+  {
+    dealii::TimerOutput::Scope scope(timer, "grains: setup");
+    particles.deserialize();
+    particles.update_cached_numbers();
+    update_partition();
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::save_contact_memory(std::ostream &out) const
+  {
+    if (contacts)
+      contacts->contact_solver().save_warm_start(out);
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::load_contact_memory(std::istream &in)
+  {
+    if (contacts)
+      contacts->contact_solver().load_warm_start(in);
+  }
+
+
+  template <int dim>
+  void
   Grains<dim>::initialize(const std::vector<GrainSeed<dim>> &seeds)
   {
     dealii::TimerOutput::Scope scope(timer, "grains: setup");

@@ -21,11 +21,12 @@ namespace ImmersedGrains
   void
   RunLog::open(const std::string &file_name,
                const bool         is_root,
-               const bool         echo)
+               const bool         echo,
+               const bool         append)
   {
     if (!is_root)
       return;
-    file.open(file_name);
+    file.open(file_name, append ? std::ios::app : std::ios::out);
     AssertThrow(file, dealii::ExcMessage("Cannot write " + file_name));
     buffer.first  = file.rdbuf();
     buffer.second = echo ? std::cout.rdbuf() : nullptr;

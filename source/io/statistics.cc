@@ -3,7 +3,11 @@
 #include <immersed_grains/io/statistics.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <iomanip>
+#include <string>
+#include <vector>
 
 namespace ImmersedGrains
 {
@@ -16,10 +20,29 @@ namespace ImmersedGrains
 
 
   void
-  Statistics::open(const std::string &file_name, const bool is_root)
+  Statistics::open(const std::string &file_name,
+                   const bool         is_root,
+                   const int          keep_through_step)
   {
     if (!is_root)
       return;
+    if (keep_through_step >= 0)
+    {
+      std::vector<std::string> kept;
+      {
+        std::ifstream old(file_name);
+        std::string   line;
+        std::getline(old, line); // the header
+        while (std::getline(old, line))
+          if (!line.empty() && std::stod(line) <= keep_through_step)
+            kept.push_back(line);
+      }
+      open(file_name, true);
+      for (const auto &line : kept)
+        file << line << '\n';
+      file.flush();
+      return;
+    }
     file.open(file_name);
     AssertThrow(file, dealii::ExcMessage("Cannot write " + file_name));
     for (unsigned int i = 0; i < columns.size(); ++i)
@@ -51,6 +74,29 @@ namespace ImmersedGrains
   Statistics::has(const std::string &column) const
   {
     return values.count(column) > 0;
+  }
+
+
+  void
+  Statistics::save_values(std::ostream &out) const
+  {
+    out << std::hexfloat;
+    for (const auto &[name, value] : values)
+      out << name << ' ' << value << '\n';
+    out << std::defaultfloat;
+  }
+
+
+  void
+  Statistics::load_values(std::istream &in)
+  {
+    std::string name, value;
+    while (in >> name >> value)
+    {
+      const auto it = values.find(name);
+      if (it != values.end())
+        it->second = std::strtod(value.c_str(), nullptr);
+    }
   }
 
 

@@ -138,7 +138,7 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  std::vector<bool>
+  std::vector<unsigned int>
   Adaptivity<dim>::grain_band(
     const dealii::Particles::ParticleHandler<dim> &grains) const
   {
@@ -161,7 +161,10 @@ namespace ImmersedGrains
 
     const auto vertex_cells = dealii::GridTools::vertex_to_cell_map(
       static_cast<const dealii::Triangulation<dim> &>(triangulation));
-    for (unsigned int layer = 0; layer < parameters.band_width; ++layer)
+    // One layer beyond the band: cells there are kept, not coarsened, or
+    // a parent coarsened next to the band would reach into it and be
+    // refined again at the next adaptation, and so on.
+    for (unsigned int layer = 0; layer < parameters.band_width + 1; ++layer)
     {
       marked.update_ghost_values();
       std::vector<dealii::types::global_dof_index> grow;
@@ -196,15 +199,16 @@ namespace ImmersedGrains
       }
       marked.zero_out_ghost_values();
       for (const auto i : grow)
-        marked[i] = 1;
+        marked[i] = layer + 2;
     }
 
-    std::vector<bool> band(triangulation.n_active_cells(), false);
+    std::vector<unsigned int> band(triangulation.n_active_cells(), 0);
     for (const auto &cell : cells.active_cell_iterators())
       if (cell->is_locally_owned())
       {
         cell->get_dof_indices(index);
-        band[cell->active_cell_index()] = marked[index[0]] != 0;
+        band[cell->active_cell_index()] =
+          static_cast<unsigned int>(marked[index[0]]);
       }
     return band;
   }
@@ -244,7 +248,7 @@ namespace ImmersedGrains
                                         parameters.coarsen_fraction);
     }
 
-    std::vector<bool> band;
+    std::vector<unsigned int> band;
     if (parameters.around_grains && grains != nullptr)
       band = grain_band(*grains);
 
@@ -253,12 +257,18 @@ namespace ImmersedGrains
       if (!cell->is_locally_owned())
         continue;
       const unsigned int level = cell->level();
-      const bool in_band = !band.empty() && band[cell->active_cell_index()];
+      const unsigned int distance =
+        band.empty() ? 0 : band[cell->active_cell_index()];
+      const bool in_band =
+        distance > 0 && distance <= parameters.band_width + 1;
+      const bool beside_band = distance == parameters.band_width + 2;
       if (in_band)
       {
         cell->clear_coarsen_flag();
         cell->set_refine_flag();
       }
+      else if (beside_band)
+        cell->clear_coarsen_flag();
       else if (!parameters.velocity_kelly)
         cell->set_coarsen_flag();
       // The levels and the cell-size floor overrule the criteria.
@@ -274,36 +284,31 @@ namespace ImmersedGrains
         cell->clear_refine_flag();
         cell->set_coarsen_flag();
       }
-      if (in_band && cell->coarsen_flag_set() && level <= parameters.max_level)
+      if ((in_band || beside_band) && cell->coarsen_flag_set() &&
+          level <= parameters.max_level)
         cell->clear_coarsen_flag();
     }
 
-    bool any = false;
-    for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_locally_owned() &&
-          (cell->refine_flag_set() || cell->coarsen_flag_set()))
-      {
-        // A coarsen flag only counts if all siblings carry one; the
-        // triangulation decides that in prepare_coarsening_and_refinement.
-        any = true;
-        break;
-      }
-    if (!dealii::Utilities::MPI::logical_or(any,
-                                            triangulation.get_communicator()))
+    // Whether any owned cell carries a flag, on any rank.
+    const auto flagged = [this]()
+    {
+      bool any = false;
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (cell->is_locally_owned() &&
+            (cell->refine_flag_set() || cell->coarsen_flag_set()))
+        {
+          any = true;
+          break;
+        }
+      return dealii::Utilities::MPI::logical_or(
+        any, triangulation.get_communicator());
+    };
+    if (!flagged())
       return false;
-    const auto before = triangulation.n_global_active_cells();
-    (void)before;
+    // The triangulation keeps a coarsen flag only where all siblings carry
+    // one, and adds the refinements that keep neighbours within a level.
     triangulation.prepare_coarsening_and_refinement();
-    bool changes = false;
-    for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_locally_owned() &&
-          (cell->refine_flag_set() || cell->coarsen_flag_set()))
-      {
-        changes = true;
-        break;
-      }
-    return dealii::Utilities::MPI::logical_or(changes,
-                                              triangulation.get_communicator());
+    return flagged();
   }
 
 

@@ -165,6 +165,16 @@ namespace ImmersedGrains
   Geometry<dim>::create_mesh(
     dealii::parallel::distributed::Triangulation<dim> &tria) const
   {
+    create_coarse_mesh(tria);
+    tria.refine_global(initial_refinement);
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::create_coarse_mesh(
+    dealii::parallel::distributed::Triangulation<dim> &tria) const
+  {
     dealii::GridGenerator::subdivided_hyper_rectangle(
       tria, subdivisions, lower_corner, upper_corner, /*colorize=*/true);
 
@@ -178,8 +188,6 @@ namespace ImmersedGrains
           tria, 2 * d, 2 * d + 1, d, periodic_faces);
     if (!periodic_faces.empty())
       tria.add_periodicity(periodic_faces);
-
-    tria.refine_global(initial_refinement);
   }
 
 

@@ -248,6 +248,16 @@ namespace ImmersedGrains
       void
       finish(GrainArrays<dim> &grains);
 
+      /// The impulses kept for the next warm start, one contact a line,
+      /// exactly (hexadecimal floating point).
+      void
+      save_warm_start(std::ostream &out) const;
+
+      /// Adds such lines to the kept impulses (a key found twice keeps
+      /// the first).
+      void
+      load_warm_start(std::istream &in);
+
       const ContactImpulses<dim> &
       pair_impulses() const;
 

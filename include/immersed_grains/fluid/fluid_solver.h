@@ -74,6 +74,23 @@ namespace ImmersedGrains
     void
     finish_mesh_change();
 
+    /** Before the triangulation is saved: the three states attached to
+     *  it (after the grains' data if both are saved: the order of loading
+     *  follows). */
+    void
+    prepare_for_serialization();
+
+    /** After a saved triangulation was loaded and setup_dofs(): the three
+     *  states read back. */
+    void
+    deserialize();
+
+    /** The time-stepping state (time, step sizes, steps done), exactly. */
+    void
+    save_state(std::ostream &out) const;
+    void
+    load_state(std::istream &in);
+
     void
     set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields);
 

@@ -90,6 +90,13 @@ namespace ImmersedGrains
     double
     max_contact_force() const;
 
+    /** The contact solver's warm-start memory (ContactSolver). */
+    Contact::ContactSolver<dim> &
+    contact_solver()
+    {
+      return solver;
+    }
+
     /** The contacts this rank solved in the last step, with their forces. */
     std::vector<ContactForce>
     contact_forces() const;

@@ -215,6 +215,22 @@ namespace ImmersedGrains
     void
     finish_mesh_change();
 
+    /** Before the triangulation is saved: every grain attached to it. */
+    void
+    prepare_for_serialization();
+
+    /** After a saved triangulation was loaded: the grains back, instead
+     *  of initialize() (collective). */
+    void
+    deserialize();
+
+    /** The contact solver's warm-start impulses (empty without contacts):
+     *  this rank's into @p out; @p in may hold several ranks' lines. */
+    void
+    save_contact_memory(std::ostream &out) const;
+    void
+    load_contact_memory(std::istream &in);
+
     const GrainPropertyLayout &
     layout() const;
 

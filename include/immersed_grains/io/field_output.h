@@ -32,6 +32,13 @@ namespace ImmersedGrains
           unsigned int                                             step,
           const std::function<void(dealii::DataOut<dim> &)>       &add_fields);
 
+    /** The (time, file) records of the PVD file, for a checkpoint. */
+    std::vector<std::pair<double, std::string>> &
+    pvd_records()
+    {
+      return records;
+    }
+
   private:
     std::string                                 directory;
     MPI_Comm                                    comm;

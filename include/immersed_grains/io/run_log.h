@@ -21,7 +21,10 @@ namespace ImmersedGrains
 
     /** Starts writing to @p file_name; @p echo also copies to stdout. */
     void
-    open(const std::string &file_name, bool is_root, bool echo);
+    open(const std::string &file_name,
+         bool               is_root,
+         bool               echo,
+         bool               append = false);
 
     std::ostream &
     stream();

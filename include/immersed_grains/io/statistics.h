@@ -20,9 +20,20 @@ namespace ImmersedGrains
   public:
     explicit Statistics(std::vector<std::string> columns);
 
-    /** Opens DIR/statistics.csv and writes the header (rank 0 only). */
+    /** Opens DIR/statistics.csv and writes the header (rank 0 only).
+     *  With @p keep_through_step >= 0 (a resumed run) the rows the file
+     *  has up to that step are kept and new rows appended; later ones (of
+     *  a run that went on past its last checkpoint) are dropped. */
     void
-    open(const std::string &file_name, bool is_root);
+    open(const std::string &file_name,
+         bool               is_root,
+         int                keep_through_step = -1);
+
+    /** Every column's current value, exactly. */
+    void
+    save_values(std::ostream &out) const;
+    void
+    load_values(std::istream &in);
 
     void
     set(const std::string &column, double value);

@@ -70,11 +70,12 @@ namespace ImmersedGrains
     }
 
   private:
-    /** Owned cells that hold a grain, widened by band_width layers of
-     *  cells (sharing a vertex), ghost layers exchanged between layers so
-     *  that the band does not depend on the partition. Indexed by
-     *  active_cell_index(). */
-    std::vector<bool>
+    /** For each owned cell (by active_cell_index()): 1 if it holds a
+     *  grain, k + 1 if it is k layers of cells (sharing a vertex) away from
+     *  one, up to band_width + 1 layers; 0 farther. Ghost values are
+     *  exchanged between layers, so that the band does not depend on the
+     *  partition. */
+    std::vector<unsigned int>
     grain_band(const dealii::Particles::ParticleHandler<dim> &grains) const;
 
     const Parameters                                  &parameters;

@@ -40,6 +40,12 @@ namespace ImmersedGrains
     void
     parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
+    /** Builds the coarse mesh and sets periodicity (what a saved mesh is
+     *  loaded onto). */
+    void
+    create_coarse_mesh(
+      dealii::parallel::distributed::Triangulation<dim> &tria) const;
+
     /** Builds the coarse mesh, sets periodicity, refines globally. */
     void
     create_mesh(dealii::parallel::distributed::Triangulation<dim> &tria) const;
