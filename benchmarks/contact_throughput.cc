@@ -10,8 +10,8 @@
 // solve (setup and write-back included), nanoseconds per update (one
 // contact visited once in a sweep, or once in an APGD iteration's scatter
 // and gather), the time per step to converge, and the neighbour search
-// time per step. Goal (doc/DESIGN): a few ns per contact update, 2e7
-// updates/s per core.
+// time per step. Goal: a few ns per contact update, 2e7 updates/s per
+// core.
 //
 // Usage: contact_throughput [--friction MU] [--solver gauss-seidel|apgd]
 //                           [--shuffle] [dim] [N ...]

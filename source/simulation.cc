@@ -28,7 +28,8 @@ namespace ImmersedGrains
         .count();
     }
 
-    // The statistics.csv columns: the interface contract first (DESIGN.md).
+    // The statistics.csv columns in their fixed order, the core set (step
+    // to wall_time) first.
     std::vector<std::string>
     statistics_columns(const int dim)
     {

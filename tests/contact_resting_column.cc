@@ -3,15 +3,16 @@
 // position update), in 2D and 3D, in vacuum and in a fluid at rest with
 // buoyancy and implicit drag (inverse mass 1/(m + dt beta)).
 //
-// Statics (doc/REFERENCES): the contact under grain j from the top carries
-// j m g (1 - rho/rho_p); checked at every step to 1e-8 relative. The gap
-// term keeps the column where it is: what the solver leaves unconverged
-// (relative impulse change 1e-12 per sweep) moves a grain by about 1e-13 r
-// within a step and the next step takes it back, so the drift stays below
-// 1e-11 r over the run instead of adding up. Projected Gauss-Seidel needs
-// O(n^2) sweeps on a column of n grains from scratch; warm starting from the
-// last step must cut that to a tenth in every later step, also after the
-// grains are renumbered (matched by ids).
+// Statics (doc/references.md, "Resting column"): the contact under grain
+// j from the top carries j m g (1 - rho/rho_p); checked at every step to
+// 1e-8 relative. The gap term keeps the column where it is: what the
+// solver leaves unconverged (relative impulse change 1e-12 per sweep)
+// moves a grain by about 1e-13 r within a step and the next step takes it
+// back, so the drift stays below 1e-11 r over the run instead of adding
+// up. Projected Gauss-Seidel needs O(n^2) sweeps on a column of n grains
+// from scratch; warm starting from the last step must cut that to a tenth
+// in every later step, also after the grains are renumbered (matched by
+// ids).
 
 #include <immersed_grains/contact/bucket_grid.h>
 #include <immersed_grains/contact/contact_solver.h>

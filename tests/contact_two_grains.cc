@@ -1,6 +1,6 @@
 // Two-body collisions through the whole contact chain (bucket grid or walls,
 // then ContactSolver) against Newton's law for rigid spheres
-// (doc/REFERENCES: v1' = v1 - (1+e) m2/(m1+m2) (v12.n) n,
+// (doc/references.md, "Collisions": v1' = v1 - (1+e) m2/(m1+m2) (v12.n) n,
 // v2' = v2 + (1+e) m1/(m1+m2) (v12.n) n), head-on and oblique, e in
 // {0, 0.5, 1}, equal and unequal masses, discs and spheres; a grain against a
 // fixed grain and a moving wall (m2 -> infinity); the contact laws of the

@@ -1,9 +1,9 @@
 // A column of 10 touching grains (r = 0.05, m = 1) on the floor, stepped
 // 1000 times through Grains<dim> on a ParticleHandler (gather, free
 // velocities, distributed contact solve, position update, sort), 2D and
-// 3D. Statics (REFERENCES.md): the contact under grain j from the top
-// carries j m g; checked for every contact at every step to 1e-8
-// relative, and nothing may drift (centre heights to 1e-11 r).
+// 3D. Statics (doc/references.md, "Resting column"): the contact under
+// grain j from the top carries j m g; checked for every contact at every
+// step to 1e-8 relative, and nothing may drift (centre heights to 1e-11 r).
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/mpi.h>

@@ -15,6 +15,16 @@ namespace ImmersedGrains
       , settings(settings)
       , pressure_mass(pressure_mass)
   {
+    if (settings.velocity_ilu)
+    {
+      // One layer of overlap, as for the AMG's smoother below.
+      dealii::TrilinosWrappers::PreconditionILU::AdditionalData data(0,
+                                                                     0.,
+                                                                     1.,
+                                                                     1);
+      velocity_ilu.initialize(system_matrix.block(0, 0), data);
+    }
+    else
     {
       dealii::TrilinosWrappers::PreconditionAMG::AdditionalData data;
       data.constant_modes        = settings.velocity_constant_modes;
@@ -54,6 +64,7 @@ namespace ImmersedGrains
     velocity_tmp.reinit(system_matrix.block(0, 0).locally_owned_range_indices(),
                         system_matrix.get_mpi_communicator());
     velocity_residual.reinit(velocity_tmp);
+    velocity_correction.reinit(velocity_tmp);
     pressure_tmp.reinit(system_matrix.block(1, 1).locally_owned_range_indices(),
                         system_matrix.get_mpi_communicator());
   }
@@ -107,7 +118,7 @@ namespace ImmersedGrains
           control,
           dealii::SolverGMRES<dealii::TrilinosWrappers::MPI::Vector>::
             AdditionalData(settings.inner_iterations + 1));
-        gmres.solve(A, dst, src, velocity_amg);
+        gmres.solve(A, dst, src, velocity_preconditioner());
       }
       catch (const dealii::SolverControl::NoConvergence &)
       {
@@ -116,15 +127,25 @@ namespace ImmersedGrains
       return;
     }
 
-    velocity_amg.vmult(dst, src);
+    // A stationary iteration with the V-cycle or the ILU.
+    const auto &preconditioner = velocity_preconditioner();
+    preconditioner.vmult(dst, src);
     for (unsigned int cycle = 1; cycle < settings.velocity_cycles; ++cycle)
     {
       A.vmult(velocity_tmp, dst);
       velocity_tmp.sadd(-1.0, 1.0, src);
-      dealii::TrilinosWrappers::MPI::Vector correction(velocity_tmp);
-      velocity_amg.vmult(correction, velocity_tmp);
-      dst += correction;
+      preconditioner.vmult(velocity_correction, velocity_tmp);
+      dst += velocity_correction;
     }
+  }
+
+
+  const dealii::TrilinosWrappers::PreconditionBase &
+  BlockSchurPreconditioner::velocity_preconditioner() const
+  {
+    if (settings.velocity_ilu)
+      return velocity_ilu;
+    return velocity_amg;
   }
 
 

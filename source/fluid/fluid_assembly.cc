@@ -243,6 +243,10 @@ namespace ImmersedGrains
 
     double       max_beta       = 0;
     unsigned int averaged_cells = 0;
+    // The largest ratio of the viscous and advective parts of A to its
+    // mass-and-drag part, at the spacing of the velocity nodes: where it
+    // is small, A is nearly diagonal (the entry Velocity preconditioner).
+    double max_viscous_number = 0;
 
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
@@ -447,6 +451,15 @@ namespace ImmersedGrains
           // diagonal of the mass-and-drag part c M of A,
           // c = phi rho a0/dt + beta, plus its floor (schur_floor_factor).
           const double mass_weight = phi / mu * JxW;
+          const double c           = mass + beta;
+          const double spacing     = h / fe.degree;
+          double       viscous_number =
+            c > 0 ? phi * mu / (c * spacing * spacing) :
+                    std::numeric_limits<double>::infinity();
+          if (advection && c > 0)
+            viscous_number =
+              std::max(viscous_number, phi * rho * u.norm() / (c * spacing));
+          max_viscous_number = std::max(max_viscous_number, viscous_number);
           cell_drag += beta * JxW;
           cell_viscosity += phi * mu * JxW;
           max_beta = std::max(max_beta, beta);
@@ -638,6 +651,8 @@ namespace ImmersedGrains
       reaction_diagonal.compress(dealii::VectorOperation::add);
       schur_has_drag =
         dealii::Utilities::MPI::max(max_beta, mpi_communicator) > 0;
+      velocity_viscous_number =
+        dealii::Utilities::MPI::max(max_viscous_number, mpi_communicator);
     }
   }
 

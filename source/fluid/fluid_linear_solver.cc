@@ -1,6 +1,7 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/solver_gmres.h>
+#include <deal.II/lac/trilinos_index_access.h>
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_sparsity_pattern.h>
@@ -14,6 +15,38 @@
 
 namespace ImmersedGrains
 {
+  namespace
+  {
+    // Calls f(row, columns, values) for every locally owned row of
+    // @p matrix, with global indices, through Epetra's views of its rows.
+    // deal.II's iterators copy the whole row into a cache at begin() and
+    // again at end(): the loops below spent 15 % of a three-step 3D run
+    // there (perf, Lethe's scene).
+    template <typename RowFunction>
+    void
+    for_each_owned_row(const dealii::TrilinosWrappers::SparseMatrix &matrix,
+                       const RowFunction                            &f)
+    {
+      const Epetra_CrsMatrix                      &m = matrix.trilinos_matrix();
+      std::vector<dealii::types::global_dof_index> columns;
+      for (int row = 0; row < m.NumMyRows(); ++row)
+      {
+        int     n       = 0;
+        double *values  = nullptr;
+        int    *indices = nullptr;
+        m.ExtractMyRowView(row, n, values, indices);
+        columns.resize(n);
+        for (int k = 0; k < n; ++k)
+          columns[k] = dealii::TrilinosWrappers::global_column_index(m, indices[k]);
+        f(static_cast<dealii::types::global_dof_index>(
+            dealii::TrilinosWrappers::global_row_index(m, row)),
+          columns,
+          values);
+      }
+    }
+  } // namespace
+
+
   template <int dim>
   void
   FluidSolver<dim>::build_preconditioner()
@@ -23,8 +56,32 @@ namespace ImmersedGrains
     built_mass_coefficient = mass_coefficient();
     ++builds;
 
+    // ILU or AMG for the velocity block: where mass and drag dominate its
+    // viscous and advective parts on the scale of the velocity nodes, A is
+    // nearly diagonal, and one ILU sweep, a few matrix-vector products'
+    // cost, replaces two V-cycles of ILU-smoothed AMG. Lethe's
+    // sedimentation scene (viscous number 2e-3): 8 instead of 6 outer
+    // iterations, 25 instead of 200 ms each. The drag-jump benchmark at 2D
+    // level 7: the ILU's FGMRES time is a quarter to a third of the AMG's
+    // up to a viscous number of 0.7 (9-19 iterations), about the same at
+    // 7 (55 iterations), three times the AMG's at 66 (191). The default
+    // threshold 0.3 keeps the ILU's count near the AMG's (doc/performance.md).
+    using Choice        = typename FluidParameters<dim>::VelocityPreconditioner;
+    const bool previous = velocity_ilu;
+    velocity_ilu =
+      parameters.velocity_preconditioner == Choice::ilu ||
+      (parameters.velocity_preconditioner == Choice::automatic &&
+       velocity_viscous_number < parameters.velocity_ilu_threshold);
+    if (builds == 1 || previous != velocity_ilu)
+      pcout << "  fluid: velocity block preconditioned by "
+            << (velocity_ilu ? "ILU" : "AMG") << " (viscous number "
+            << velocity_viscous_number << ")" << std::endl;
+
     BlockSchurPreconditioner::Settings settings;
-    settings.velocity_cycles          = parameters.velocity_amg_cycles;
+    settings.velocity_ilu             = velocity_ilu;
+    settings.velocity_cycles          = velocity_ilu ?
+                                          parameters.velocity_ilu_sweeps :
+                                          parameters.velocity_amg_cycles;
     settings.inner_iterations         = parameters.velocity_inner_iterations;
     settings.inner_tolerance          = parameters.velocity_inner_tolerance;
     settings.pressure_mass_iterations = parameters.pressure_mass_iterations;
@@ -81,38 +138,45 @@ namespace ImmersedGrains
                                                           owned_partitioning[1],
                                                           mpi_communicator);
         for (const auto i : owned_partitioning[1])
-        {
           pattern.add(i, i);
-          for (auto entry = product.begin(i); entry != product.end(i); ++entry)
-            pattern.add(i, entry->column());
-        }
+        for_each_owned_row(product,
+                           [&](const auto row, const auto &columns, auto) {
+                             pattern.add_entries(row,
+                                                 columns.begin(),
+                                                 columns.end());
+                           });
         pattern.compress();
         schur_diagonal_matrix.reinit(pattern);
       }
       schur_diagonal_matrix = 0;
       double       mean     = 0;
       unsigned int n        = 0;
-      for (const auto i : owned_partitioning[1])
-        for (auto entry = product.begin(i); entry != product.end(i); ++entry)
-        {
-          schur_diagonal_matrix.set(i, entry->column(), entry->value());
-          if (entry->column() == i && entry->value() != 0)
-          {
-            mean += entry->value();
-            ++n;
-          }
-        }
+      for_each_owned_row(
+        product,
+        [&](const auto row, const auto &columns, const double *values) {
+          schur_diagonal_matrix.set(
+            row, columns.size(), columns.data(), values, false);
+          for (unsigned int k = 0; k < columns.size(); ++k)
+            if (columns[k] == row && values[k] != 0)
+            {
+              mean += values[k];
+              ++n;
+            }
+        });
       schur_diagonal_matrix.compress(dealii::VectorOperation::insert);
       // The pressure block -C (the grains' pressure mobility, zero without
       // grains) belongs to the Schur complement C + B A^-1 B^T; its pattern
       // lies within the product's.
-      const auto &pressure_block = system_matrix.block(1, 1);
-      for (const auto i : owned_partitioning[1])
-        for (auto entry = pressure_block.begin(i);
-             entry != pressure_block.end(i);
-             ++entry)
-          if (entry->value() != 0)
-            schur_diagonal_matrix.add(i, entry->column(), -entry->value());
+      std::vector<double> negated;
+      for_each_owned_row(
+        system_matrix.block(1, 1),
+        [&](const auto row, const auto &columns, const double *values) {
+          negated.assign(values, values + columns.size());
+          for (double &value : negated)
+            value = -value;
+          schur_diagonal_matrix.add(
+            row, columns.size(), columns.data(), negated.data(), true);
+        });
       schur_diagonal_matrix.compress(dealii::VectorOperation::add);
       mean = dealii::Utilities::MPI::sum(mean, mpi_communicator) /
              std::max(1u, dealii::Utilities::MPI::sum(n, mpi_communicator));

@@ -161,6 +161,33 @@ namespace ImmersedGrains
           "(B diag(c M)^{-1} B^T)^{-1}, c = phi rho a0/dt + beta (mass- and "
           "drag-dominated limit; a Darcy-like pressure Laplacian), as "
           "Cahouet-Chabard do, or either limit alone.");
+        prm.declare_entry(
+          "Velocity preconditioner",
+          "auto",
+          Selection("auto|AMG|ILU"),
+          "Approximate inverse of the velocity block A = c M + K_visc + "
+          "K_adv (c = phi rho a0/dt + beta): AMG V-cycles (Velocity AMG "
+          "cycles), one incomplete LU factorisation of A, or auto: the ILU "
+          "where the block's viscous number, the largest over the mesh of "
+          "phi mu/(c h^2) and phi rho |u|/(c h) with h the cell's velocity "
+          "node spacing, is below Velocity ILU threshold, else AMG. Small "
+          "viscous numbers are time steps far below the viscous time h^2/nu "
+          "or strong drag: A is then nearly its diagonal and the ILU does in "
+          "one sweep what a V-cycle does at several times its cost "
+          "(doc/performance.md). Steady problems without drag everywhere "
+          "always take AMG.");
+        prm.declare_entry("Velocity ILU threshold",
+                          "0.3",
+                          Double(0),
+                          "With Velocity preconditioner = auto, the viscous "
+                          "number below which the ILU is used "
+                          "(doc/performance.md measures the choice).");
+        prm.declare_entry("Velocity ILU sweeps",
+                          "1",
+                          Integer(1, 10),
+                          "ILU sweeps per application of the velocity "
+                          "block's inverse where the ILU is chosen "
+                          "(doc/performance.md).");
         prm.declare_entry("Velocity AMG cycles",
                           "2",
                           Integer(1, 10),
@@ -265,6 +292,14 @@ namespace ImmersedGrains
                                     (schur == "pressure Laplacian" ?
                                        SchurApproximation::pressure_laplace :
                                        SchurApproximation::cahouet_chabard);
+        const std::string velocity = prm.get("Velocity preconditioner");
+        velocity_preconditioner =
+          velocity == "AMG" ?
+            VelocityPreconditioner::amg :
+            (velocity == "ILU" ? VelocityPreconditioner::ilu :
+                                 VelocityPreconditioner::automatic);
+        velocity_ilu_threshold = prm.get_double("Velocity ILU threshold");
+        velocity_ilu_sweeps     = prm.get_integer("Velocity ILU sweeps");
         velocity_amg_cycles     = prm.get_integer("Velocity AMG cycles");
         velocity_inner_iterations =
           prm.get_integer("Velocity inner iterations");

@@ -44,7 +44,8 @@ namespace ImmersedGrains
     virtual double
     coefficient(const DragInput &input) const = 0;
 
-    /** Particle Reynolds number 2 r rho |w| phi / mu (DESIGN.md). */
+    /** Particle Reynolds number 2 r rho |w| phi / mu (the seed's
+     *  definition, Constant et al. 2019; doc/references.md). */
     static double
     reynolds(const DragInput &input);
 

@@ -16,8 +16,9 @@ namespace ImmersedGrains
    *   [ B  0   ] [p] = [g],           [ 0  -S  ],
    *
    * applied as p = -S~^{-1} g, u = A~^{-1}(f - B^T p). A~^{-1} is one or
-   * more AMG V-cycles on the velocity block, or a few Krylov iterations
-   * preconditioned by them (a variable preconditioner: FGMRES outside). S~^{-1}
+   * more AMG V-cycles on the velocity block, or one ILU where mass and drag
+   * dominate A, or a few Krylov iterations preconditioned by either (a
+   * variable preconditioner: FGMRES outside). S~^{-1}
    * is the Cahouet-Chabard sum M_w^{-1} + S_c^{-1} of a pressure mass matrix
    * weighted by phi/mu (the viscous limit of S) and S_c = B diag(c M)^{-1} B^T,
    * the limit where mass and drag c = phi rho a0/dt + beta dominate, the
@@ -33,6 +34,9 @@ namespace ImmersedGrains
 
     struct Settings
     {
+      // ILU(0) of A instead of AMG: for a mass- or drag-dominated A.
+      bool velocity_ilu = false;
+      // V-cycles, or ILU sweeps, per application of A~^{-1}.
       unsigned int velocity_cycles = 2;
 
       // If positive: A~^{-1} is up to this many GMRES iterations
@@ -76,7 +80,12 @@ namespace ImmersedGrains
     const Settings                                     settings;
     const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass;
 
+    // The one of these that A~^{-1} applies.
+    const dealii::TrilinosWrappers::PreconditionBase &
+    velocity_preconditioner() const;
+
     dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
+    dealii::TrilinosWrappers::PreconditionILU velocity_ilu;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;
     dealii::TrilinosWrappers::PreconditionAMG pressure_laplace_amg;
     bool                                      use_mass    = false;
@@ -84,6 +93,7 @@ namespace ImmersedGrains
 
     mutable dealii::TrilinosWrappers::MPI::Vector velocity_tmp;
     mutable dealii::TrilinosWrappers::MPI::Vector velocity_residual;
+    mutable dealii::TrilinosWrappers::MPI::Vector velocity_correction;
     mutable dealii::TrilinosWrappers::MPI::Vector pressure_tmp;
   };
 } // namespace ImmersedGrains

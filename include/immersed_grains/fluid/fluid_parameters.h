@@ -64,6 +64,22 @@ namespace ImmersedGrains
     unsigned int       max_linear_iterations = 500;
     SchurApproximation schur_approximation =
       SchurApproximation::cahouet_chabard;
+    // The velocity block's approximate inverse: AMG V-cycles, one ILU
+    // (where mass and drag dominate viscosity and advection, A is nearly
+    // diagonal and an ILU is as good as a V-cycle at a fraction of its
+    // cost), or chosen per build by the block's viscous number
+    // (fluid_linear_solver.cc).
+    enum class VelocityPreconditioner
+    {
+      automatic,
+      amg,
+      ilu
+    };
+    VelocityPreconditioner velocity_preconditioner =
+      VelocityPreconditioner::automatic;
+    // With `auto`, the ILU is chosen below this viscous number.
+    double       velocity_ilu_threshold       = 0.3;
+    unsigned int velocity_ilu_sweeps          = 1;
     unsigned int velocity_amg_cycles          = 2;
     unsigned int velocity_inner_iterations    = 0;
     double       velocity_inner_tolerance     = 1e-6;

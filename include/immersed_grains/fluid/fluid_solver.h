@@ -266,6 +266,11 @@ namespace ImmersedGrains
     // Whether any drag is present; without it and without inertia (steady
     // Stokes) the Laplacian term of the Schur approximation is left out.
     bool schur_has_drag = false;
+    // The velocity block's viscous number in the last assembly of the
+    // preconditioner matrices (fluid_assembly.cc), and whether the last
+    // build chose the ILU for it.
+    double velocity_viscous_number = 0;
+    bool   velocity_ilu            = false;
     // Preconditioner reuse: the iterations of the first solve after the
     // last rebuild, whether a slower solve asked for a new one, and the
     // mass coefficient it was built for.

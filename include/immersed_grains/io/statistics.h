@@ -11,7 +11,8 @@ namespace ImmersedGrains
 {
   /**
    * The per-step table written to statistics.csv: a fixed column order set
-   * once (the interface contract of DESIGN.md first), one row per call to
+   * once (the core columns, step to wall_time, first: see
+   * statistics_columns() in source/simulation.cc), one row per call to
    * write_row(). Only rank 0 writes; the row is flushed at once so that a
    * run that stops early still leaves its history.
    */
