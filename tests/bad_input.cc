@@ -232,6 +232,11 @@ end
              "subsection Adaptivity\n set Enabled = true\nend\n",
          "Enabled",
          "true"},
+        {"grain_weight_not_a_number",
+         "set Dimension = 3\nsubsection Load balancing\n set Grain weight = "
+         "heavy\nend\n",
+         "Grain weight",
+         "heavy"},
   };
 
   unsigned int failures = 0;

@@ -4,6 +4,8 @@
 #include <immersed_grains/parameters.h>
 
 #include <cmath>
+#include <exception>
+#include <string>
 
 namespace ImmersedGrains
 {
@@ -17,13 +19,15 @@ namespace ImmersedGrains
     {
       prm.declare_entry(
         "Grain weight",
-        "1.5",
-        Double(0, 1000),
+        "auto",
+        Anything(),
         "On several MPI ranks: the work of one grain relative to one cell's "
-        "fluid work, for partitioning the mesh (a 2D cloud step on one "
-        "rank: about 25 us per cell for the fluid and 37 us per grain for "
-        "the drag, contacts and sorting, doc/adaptivity.md). 0: balance "
-        "cells only.");
+        "fluid work, for partitioning the mesh; a number from 0 (balance "
+        "cells only) to 1000, or auto: 1.5 in 2D, 0.2 in 3D, the measured "
+        "ratios. A 2D cloud step on one rank: about 25 us per cell for the "
+        "fluid and 37 us per grain for the drag, contacts and sorting "
+        "(doc/adaptivity.md); Lethe's 3D sedimentation scene: 216 us per "
+        "Q2-Q1 cell, 44 us per grain (doc/performance.md).");
       prm.declare_entry("Max imbalance",
                         "1.2",
                         Double(1),
@@ -38,11 +42,33 @@ namespace ImmersedGrains
   template <int dim>
   void
   LoadBalance<dim>::Parameters::parse_parameters(dealii::ParameterHandler &prm,
-                                                 const std::string &)
+                                                 const std::string &file)
   {
     prm.enter_subsection("Load balancing");
     {
-      grain_weight  = prm.get_double("Grain weight");
+      const InputLocation where{file, "Load balancing"};
+      const std::string   weight = prm.get("Grain weight");
+      if (weight == "auto")
+        grain_weight = dim == 2 ? 1.5 : 0.2;
+      else
+      {
+        std::size_t end = 0;
+        try
+        {
+          grain_weight = std::stod(weight, &end);
+        }
+        catch (const std::exception &)
+        {
+          end = 0;
+        }
+        where.require(end > 0 &&
+                        weight.find_first_not_of(" \t", end) ==
+                          std::string::npos &&
+                        grain_weight >= 0 && grain_weight <= 1000,
+                      "Grain weight",
+                      weight,
+                      "must be auto or a number from 0 to 1000");
+      }
       max_imbalance = prm.get_double("Max imbalance");
     }
     prm.leave_subsection();

@@ -28,7 +28,7 @@ namespace ImmersedGrains
       void
       parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
-      double grain_weight  = 1.5;
+      double grain_weight  = dim == 2 ? 1.5 : 0.2;
       double max_imbalance = 1.2;
     };
 
