@@ -234,7 +234,7 @@ end
          "true"},
         {"grain_weight_not_a_number",
          "set Dimension = 3\nsubsection Load balancing\n set Grain weight = "
-         "heavy\nend\n",
+             "heavy\nend\n",
          "Grain weight",
          "heavy"},
   };

@@ -6,6 +6,7 @@
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
 
+#include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
 namespace ImmersedGrains
@@ -248,10 +249,12 @@ namespace ImmersedGrains
     // is small, A is nearly diagonal (the entry Velocity preconditioner).
     double max_viscous_number = 0;
 
+    unsigned int owned_cell = 0; // the cell's number for cell_scatter
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
       if (!cell->is_locally_owned())
         continue;
+      const unsigned int cell_number = owned_cell++;
       fe_values.reinit(cell);
       cell->get_dof_indices(dof_indices);
       for (unsigned int k = 0; k < dofs_per_cell; ++k)
@@ -450,12 +453,12 @@ namespace ImmersedGrains
           // needs the pressure mass matrix weighted by phi/mu and the
           // diagonal of the mass-and-drag part c M of A,
           // c = phi rho a0/dt + beta, plus its floor (schur_floor_factor).
-          const double mass_weight = phi / mu * JxW;
-          const double c           = mass + beta;
-          const double spacing     = h / fe.degree;
-          double       viscous_number =
-            c > 0 ? phi * mu / (c * spacing * spacing) :
-                    std::numeric_limits<double>::infinity();
+          const double mass_weight    = phi / mu * JxW;
+          const double c              = mass + beta;
+          const double spacing        = h / fe.degree;
+          double       viscous_number = c > 0 ?
+                                          phi * mu / (c * spacing * spacing) :
+                                          std::numeric_limits<double>::infinity();
           if (advection && c > 0)
             viscous_number =
               std::max(viscous_number, phi * rho * u.norm() / (c * spacing));
@@ -626,8 +629,11 @@ namespace ImmersedGrains
         }
       }
 
-      update_constraints.distribute_local_to_global(
-        cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
+      if (cell_scatter->is_direct(cell_number))
+        cell_scatter->add(cell_number, cell_matrix, cell_rhs);
+      else
+        update_constraints.distribute_local_to_global(
+          cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
       if (assemble_preconditioner_matrices)
       {
         if (cell_drag > 0)

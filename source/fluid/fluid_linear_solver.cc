@@ -37,7 +37,8 @@ namespace ImmersedGrains
         m.ExtractMyRowView(row, n, values, indices);
         columns.resize(n);
         for (int k = 0; k < n; ++k)
-          columns[k] = dealii::TrilinosWrappers::global_column_index(m, indices[k]);
+          columns[k] =
+            dealii::TrilinosWrappers::global_column_index(m, indices[k]);
         f(static_cast<dealii::types::global_dof_index>(
             dealii::TrilinosWrappers::global_row_index(m, row)),
           columns,
@@ -78,12 +79,11 @@ namespace ImmersedGrains
             << velocity_viscous_number << ")" << std::endl;
 
     BlockSchurPreconditioner::Settings settings;
-    settings.velocity_ilu             = velocity_ilu;
-    settings.velocity_cycles          = velocity_ilu ?
-                                          parameters.velocity_ilu_sweeps :
-                                          parameters.velocity_amg_cycles;
-    settings.inner_iterations         = parameters.velocity_inner_iterations;
-    settings.inner_tolerance          = parameters.velocity_inner_tolerance;
+    settings.velocity_ilu     = velocity_ilu;
+    settings.velocity_cycles  = velocity_ilu ? parameters.velocity_ilu_sweeps :
+                                               parameters.velocity_amg_cycles;
+    settings.inner_iterations = parameters.velocity_inner_iterations;
+    settings.inner_tolerance  = parameters.velocity_inner_tolerance;
     settings.pressure_mass_iterations = parameters.pressure_mass_iterations;
     const dealii::FEValuesExtractors::Vector velocities(0);
     dealii::DoFTools::extract_constant_modes(dof_handler,
@@ -153,7 +153,8 @@ namespace ImmersedGrains
       unsigned int n        = 0;
       for_each_owned_row(
         product,
-        [&](const auto row, const auto &columns, const double *values) {
+        [&](const auto row, const auto &columns, const double *values)
+        {
           schur_diagonal_matrix.set(
             row, columns.size(), columns.data(), values, false);
           for (unsigned int k = 0; k < columns.size(); ++k)
@@ -170,7 +171,8 @@ namespace ImmersedGrains
       std::vector<double> negated;
       for_each_owned_row(
         system_matrix.block(1, 1),
-        [&](const auto row, const auto &columns, const double *values) {
+        [&](const auto row, const auto &columns, const double *values)
+        {
           negated.assign(values, values + columns.size());
           for (double &value : negated)
             value = -value;

@@ -11,6 +11,7 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <immersed_grains/fluid/block_preconditioner.h>
+#include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
 namespace ImmersedGrains
@@ -111,7 +112,16 @@ namespace ImmersedGrains
       , velocity_shapes(fe.base_element(0))
       , pressure_shapes(fe.base_element(1))
       , mean_shapes(fe.base_element(0))
-      , forcing(parameters.forcing)
+      , forcing(
+          [&]() -> std::shared_ptr<dealii::Function<dim>>
+          {
+            if (!parameters.forcing_is_constant)
+              return parameters.forcing;
+            dealii::Vector<double> value(dim);
+            parameters.forcing->vector_value(dealii::Point<dim>(), value);
+            return std::make_shared<dealii::Functions::ConstantFunction<dim>>(
+              value);
+          }())
       , boundary_velocity(parameters.boundary_velocity)
   {
     mixture_fields = std::make_shared<PrescribedMixtureFields<dim>>(
@@ -275,7 +285,8 @@ namespace ImmersedGrains
     // The system couples everything (pressure with pressure through the
     // grains' pressure mobility, doc/theory.md 3); the preconditioner's
     // pressure mass matrix only pressure with pressure.
-    const auto make_matrix =
+    dealii::Table<2, dealii::DoFTools::Coupling> system_coupling;
+    const auto                                   make_matrix =
       [&](const bool                               pressure_only,
           const dealii::AffineConstraints<double> &constraints,
           MatrixType                              &matrix)
@@ -297,6 +308,8 @@ namespace ImmersedGrains
           coupling[c][d] =
             coupled ? dealii::DoFTools::always : dealii::DoFTools::none;
         }
+      if (!pressure_only)
+        system_coupling = coupling;
       dealii::TrilinosWrappers::BlockSparsityPattern sp(owned_partitioning,
                                                         owned_partitioning,
                                                         relevant_partitioning,
@@ -322,6 +335,17 @@ namespace ImmersedGrains
     system_rhs.reinit(owned_partitioning, mpi_communicator);
     reaction_diagonal.reinit(owned_partitioning, mpi_communicator);
     newton_update.reinit(owned_partitioning, mpi_communicator);
+    cell_scatter = std::make_unique<CellScatter<dim>>();
+    cell_scatter->reinit(dof_handler,
+                         system_coupling,
+                         update_constraints,
+                         system_matrix,
+                         system_rhs);
+    pcout << "  fluid: "
+          << dealii::Utilities::MPI::min(cell_scatter->direct_fraction(),
+                                         mpi_communicator) *
+               100
+          << "% of the cells assembled directly (the lowest rank)" << std::endl;
     preconditioner.reset();
     schur_diagonal_matrix.clear();
   }

@@ -42,7 +42,7 @@ namespace ImmersedGrains
   template <int dim>
   void
   LoadBalance<dim>::Parameters::parse_parameters(dealii::ParameterHandler &prm,
-                                                 const std::string &file)
+                                                 const std::string        &file)
   {
     prm.enter_subsection("Load balancing");
     {

@@ -91,6 +91,8 @@ namespace ImmersedGrains
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> drag_coefficient;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> grain_velocity;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> forcing;
+    // Whether the forcing's expression is a constant (numbers only).
+    bool forcing_is_constant = false;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> boundary_velocity;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>>
       open_boundary_pressure;

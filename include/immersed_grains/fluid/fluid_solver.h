@@ -25,6 +25,8 @@
 namespace ImmersedGrains
 {
   class BlockSchurPreconditioner;
+  template <int dim>
+  class CellScatter;
 
   /**
    * The volume-averaged (VANS) fluid: interstitial velocity u and pressure p
@@ -261,6 +263,10 @@ namespace ImmersedGrains
     unsigned int steps_done = 0;
     // BDF coefficients of u^{n+1}, u^n, u^{n-1} (divided by dt when used).
     std::array<double, 3> bdf = {{0, 0, 0}};
+
+    // Direct insertion of the cell matrices where the constraints allow
+    // it (cell_scatter.h), rebuilt with the matrix.
+    std::unique_ptr<CellScatter<dim>> cell_scatter;
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
     // Whether any drag is present; without it and without inertia (steady

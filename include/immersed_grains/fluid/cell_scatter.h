@@ -1,0 +1,108 @@
+#ifndef immersed_grains_fluid_cell_scatter_h
+#define immersed_grains_fluid_cell_scatter_h
+
+#include <deal.II/base/table.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/trilinos_block_sparse_matrix.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/vector.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace ImmersedGrains
+{
+  /**
+   * Adds cell matrices and right-hand sides into the fluid's Trilinos
+   * block system through the positions of their entries in Epetra's rows,
+   * found once per mesh, instead of AffineConstraints::
+   * distribute_local_to_global, which looks every entry up in the row
+   * (a binary search and a map from global to local column) at every
+   * assembly: half of the cell loop's time in 3D (doc/performance.md).
+   *
+   * A cell qualifies when all its DoFs are owned by this rank and each is
+   * either free or fixed to zero by a constraint without entries (walls,
+   * slip on faces normal to an axis): there distribute_local_to_global
+   * adds the free rows' entries in free columns, the absolute diagonal
+   * entry (or the mean absolute diagonal where it is zero) on each fixed
+   * row, and nothing else, which add() repeats entry by entry in the same
+   * order, so that the assembled system is the same to the last bit. Cells
+   * with hanging nodes, periodic or inhomogeneous constraints, or DoFs of
+   * other ranks, keep the general path.
+   */
+  template <int dim>
+  class CellScatter
+  {
+  public:
+    using MatrixType = dealii::TrilinosWrappers::BlockSparseMatrix;
+    using VectorType = dealii::TrilinosWrappers::MPI::BlockVector;
+
+    /**
+     * Finds the entries of every qualifying locally owned cell in
+     * @p matrix (built with @p coupling between the components and
+     * @p constraints) and in @p vector. Both must keep their storage until
+     * the next call: add() writes into it.
+     */
+    void
+    reinit(const dealii::DoFHandler<dim>                      &dof_handler,
+           const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
+           const dealii::AffineConstraints<double>            &constraints,
+           MatrixType                                         &matrix,
+           VectorType                                         &vector);
+
+    void
+    clear();
+
+    bool
+    empty() const;
+
+    /** Whether the @p k-th locally owned cell (in the order of
+     * DoFHandler::active_cell_iterators()) takes the direct path. */
+    bool
+    is_direct(unsigned int k) const;
+
+    /** Adds the @p k-th locally owned cell's matrix and right-hand side. */
+    void
+    add(unsigned int                      k,
+        const dealii::FullMatrix<double> &cell_matrix,
+        const dealii::Vector<double>     &cell_rhs) const;
+
+    /** The direct cells' share of the locally owned cells. */
+    double
+    direct_fraction() const;
+
+  private:
+    static constexpr std::uint16_t skip = 0xffff;
+
+    // A pair of local DoFs that the coupling table couples, with the
+    // blocks of their rows and columns; the same for every cell.
+    struct Pair
+    {
+      std::uint16_t i, j;
+      std::uint8_t  row_block, column_block;
+    };
+    std::vector<Pair> pairs;
+    unsigned int      dofs_per_cell = 0;
+
+    // Per locally owned cell: its number among the direct cells, or -1.
+    std::vector<int> direct_index;
+    // Per direct cell: each local DoF's row in its block (Epetra's local
+    // numbering) with a flag for a fixed DoF, and each pair's position in
+    // that row (skip where the pair does not enter the matrix).
+    std::vector<int>           rows;
+    std::vector<bool>          fixed;
+    std::vector<std::uint16_t> positions;
+
+    // Local DoF -> block of its row.
+    std::vector<std::uint8_t> dof_block;
+    // The values of each local row of each block, and of each vector block.
+    std::array<std::array<std::vector<double *>, 2>, 2> row_values;
+    std::array<double *, 2>                             vector_values{};
+  };
+} // namespace ImmersedGrains
+
+#endif
