@@ -66,7 +66,10 @@ namespace ImmersedGrains
     // level 7: the ILU's FGMRES time is a quarter to a third of the AMG's
     // up to a viscous number of 0.7 (9-19 iterations), about the same at
     // 7 (55 iterations), three times the AMG's at 66 (191). The default
-    // threshold 0.3 keeps the ILU's count near the AMG's (doc/performance.md).
+    // threshold 1 keeps the ILU within 30 iterations there; Lethe's scene
+    // on a 20 x 100 x 20 mesh, whose advection raises the number to 0.36,
+    // took 20 s per step with the AMG and 7-8 s with the ILU
+    // (doc/performance.md).
     using Choice        = typename FluidParameters<dim>::VelocityPreconditioner;
     const bool previous = velocity_ilu;
     velocity_ilu =

@@ -210,7 +210,7 @@ namespace ImmersedGrains
           "(doc/performance.md). Steady problems without drag everywhere "
           "always take AMG.");
         prm.declare_entry("Velocity ILU threshold",
-                          "0.3",
+                          "1",
                           Double(0),
                           "With Velocity preconditioner = auto, the viscous "
                           "number below which the ILU is used "

@@ -78,7 +78,7 @@ namespace ImmersedGrains
     VelocityPreconditioner velocity_preconditioner =
       VelocityPreconditioner::automatic;
     // With `auto`, the ILU is chosen below this viscous number.
-    double       velocity_ilu_threshold       = 0.3;
+    double       velocity_ilu_threshold       = 1;
     unsigned int velocity_ilu_sweeps          = 1;
     unsigned int velocity_amg_cycles          = 2;
     unsigned int velocity_inner_iterations    = 0;
