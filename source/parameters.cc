@@ -129,6 +129,15 @@ namespace ImmersedGrains
   }
 
 
+  bool
+  parse_number(const std::string &text, double &value)
+  {
+    std::istringstream in(text);
+    std::string        trailing;
+    return (in >> value) && !(in >> trailing);
+  }
+
+
   std::vector<double>
   parse_double_list(const std::string   &text,
                     const InputLocation &where,
@@ -138,10 +147,8 @@ namespace ImmersedGrains
     std::vector<double> values;
     for (const std::string &entry : dealii::Utilities::split_string_list(text))
     {
-      std::istringstream in(entry);
-      double             v;
-      std::string        trailing;
-      if (!(in >> v) || (in >> trailing))
+      double v;
+      if (!parse_number(entry, v))
         where.fail(parameter, text, "'" + entry + "' is not a number");
       values.push_back(v);
     }

@@ -64,6 +64,11 @@ namespace ImmersedGrains
   std::string
   one_line(const std::string &text);
 
+  /** Whether @p text is one number and nothing else but spaces; if so,
+   *  its value goes to @p value. */
+  bool
+  parse_number(const std::string &text, double &value);
+
   /** Parse "a, b, c" into doubles, requiring @p n entries (0: any). */
   std::vector<double>
   parse_double_list(const std::string   &text,

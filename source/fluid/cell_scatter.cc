@@ -26,14 +26,6 @@ namespace ImmersedGrains
 
   template <int dim>
   bool
-  CellScatter<dim>::empty() const
-  {
-    return rows.empty();
-  }
-
-
-  template <int dim>
-  bool
   CellScatter<dim>::is_direct(const unsigned int k) const
   {
     return k < direct_index.size() && direct_index[k] >= 0;
@@ -127,7 +119,12 @@ namespace ImmersedGrains
     std::vector<dealii::types::global_dof_index> dofs(dofs_per_cell);
     std::vector<int>                             cell_rows(dofs_per_cell);
     std::vector<bool>                            cell_fixed(dofs_per_cell);
-    std::vector<std::uint16_t>                   cell_positions(pairs.size());
+    // Each DoF's column in the blocks of both rows (Epetra's local
+    // numbering of the column map; -1 where absent).
+    std::array<std::vector<int>, 2> cell_columns;
+    for (auto &columns : cell_columns)
+      columns.resize(dofs_per_cell);
+    std::vector<std::uint16_t> cell_positions(pairs.size());
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
       if (!cell->is_locally_owned())
@@ -141,6 +138,13 @@ namespace ImmersedGrains
           matrix.block(block, block).trilinos_matrix();
         cell_rows[i] = m.RowMap().LID(
           static_cast<dealii::TrilinosWrappers::types::int_type>(index));
+        for (unsigned int row_block = 0; row_block < 2; ++row_block)
+          cell_columns[row_block][i] =
+            matrix.block(row_block, block)
+              .trilinos_matrix()
+              .ColMap()
+              .LID(
+                static_cast<dealii::TrilinosWrappers::types::int_type>(index));
         cell_fixed[i] = constraints.is_constrained(dofs[i]);
         direct        = block == dof_block[i] && cell_rows[i] >= 0 &&
                  (!cell_fixed[i] ||
@@ -155,13 +159,9 @@ namespace ImmersedGrains
           cell_positions[p] = skip;
           continue;
         }
-        const Epetra_CrsMatrix &m =
-          matrix.block(pair.row_block, pair.column_block).trilinos_matrix();
-        const int column =
-          m.ColMap().LID(static_cast<dealii::TrilinosWrappers::types::int_type>(
-            blocks.global_to_local(dofs[pair.j]).second));
-        const int  row   = cell_rows[pair.i];
-        const int *begin = row_indices[pair.row_block][pair.column_block][row];
+        const int  column = cell_columns[pair.row_block][pair.j];
+        const int  row    = cell_rows[pair.i];
+        const int *begin  = row_indices[pair.row_block][pair.column_block][row];
         const int *end =
           begin + row_lengths[pair.row_block][pair.column_block][row];
         const int *found = std::lower_bound(begin, end, column);

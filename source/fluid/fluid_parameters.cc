@@ -1,9 +1,11 @@
 #include <deal.II/base/exceptions.h>
+#include <deal.II/base/utilities.h>
 
 #include <immersed_grains/fluid/fluid_parameters.h>
+#include <immersed_grains/parameters.h>
 
+#include <algorithm>
 #include <cmath>
-#include <exception>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -18,31 +20,16 @@ namespace ImmersedGrains
     bool
     is_number_list(const std::string &expression)
     {
-      std::istringstream components(expression);
-      for (std::string component; std::getline(components, component, ';');)
-      {
-        const auto first = component.find_first_not_of(" \t");
-        if (first == std::string::npos)
-          return false;
-        std::size_t end = 0;
-        try
-        {
-          std::stod(component.substr(first), &end);
-        }
-        catch (const std::exception &)
-        {
-          return false;
-        }
-        if (component.find_first_not_of(" \t", first + end) !=
-            std::string::npos)
-          return false;
-      }
-      return true;
+      const auto components =
+        dealii::Utilities::split_string_list(expression, ';');
+      double value;
+      return !components.empty() &&
+             std::all_of(components.begin(),
+                         components.end(),
+                         [&](const std::string &component)
+                         { return parse_number(component, value); });
     }
-  } // namespace
 
-  namespace
-  {
     // The prescribed fields, their components and defaults, in one table so
     // that declaration and parsing cannot drift apart.
     struct FieldEntry

@@ -4,7 +4,6 @@
 #include <immersed_grains/parameters.h>
 
 #include <cmath>
-#include <exception>
 #include <string>
 
 namespace ImmersedGrains
@@ -51,24 +50,11 @@ namespace ImmersedGrains
       if (weight == "auto")
         grain_weight = dim == 2 ? 1.5 : 0.2;
       else
-      {
-        std::size_t end = 0;
-        try
-        {
-          grain_weight = std::stod(weight, &end);
-        }
-        catch (const std::exception &)
-        {
-          end = 0;
-        }
-        where.require(end > 0 &&
-                        weight.find_first_not_of(" \t", end) ==
-                          std::string::npos &&
-                        grain_weight >= 0 && grain_weight <= 1000,
+        where.require(parse_number(weight, grain_weight) && grain_weight >= 0 &&
+                        grain_weight <= 1000,
                       "Grain weight",
                       weight,
                       "must be auto or a number from 0 to 1000");
-      }
       max_imbalance = prm.get_double("Max imbalance");
     }
     prm.leave_subsection();

@@ -57,9 +57,6 @@ namespace ImmersedGrains
     void
     clear();
 
-    bool
-    empty() const;
-
     /** Whether the @p k-th locally owned cell (in the order of
      * DoFHandler::active_cell_iterators()) takes the direct path. */
     bool
