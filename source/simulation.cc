@@ -75,6 +75,9 @@ namespace ImmersedGrains
       // Most loaded rank over the mean, cells and grains weighted as for
       // partitioning (1 on one rank or without grains).
       c.emplace_back("load_imbalance");
+      for (const auto &name : dim == 2 ? CloudAnalysis<2>::column_names() :
+                                         CloudAnalysis<3>::column_names())
+        c.push_back(name);
       return c;
     }
 
@@ -163,10 +166,23 @@ namespace ImmersedGrains
                         "the initial and the final state).");
       prm.declare_entry("Terminal output",
                         "normal",
-                        Selection("normal|quiet|test"),
-                        "normal: the log on screen; quiet: only errors; test: "
+                        Selection("normal|verbose|quiet|test"),
+                        "normal: the log on screen with a progress line "
+                        "(rewritten in place on a terminal, a line every "
+                        "Progress every seconds otherwise), the details (a "
+                        "line per step, every mesh change) only in log.txt; "
+                        "verbose: the details on screen too, no progress "
+                        "line; quiet: only errors; test: "
                         "only the Test columns of each statistics row, with "
                         "6 digits (for the test suite).");
+      prm.declare_entry("Progress every seconds",
+                        "10",
+                        Double(0),
+                        "With Terminal output = normal and the screen not a "
+                        "terminal (a file, a pipe, mpirun, CI): a progress "
+                        "line every this many seconds of wall time (0: "
+                        "none). On a terminal the line is rewritten in place "
+                        "four times a second.");
       prm.declare_entry("Test columns",
                         "step, time, solid_volume",
                         Anything(),
@@ -199,6 +215,7 @@ namespace ImmersedGrains
     Adaptivity<dim>::Parameters::declare_parameters(prm);
     LoadBalance<dim>::Parameters::declare_parameters(prm);
     Checkpoint::Parameters::declare_parameters(prm);
+    CloudAnalysis<dim>::Parameters::declare_parameters(prm);
   }
 
 
@@ -209,6 +226,8 @@ namespace ImmersedGrains
       : comm(comm)
       , parameter_file(file)
       , pcout(log.stream(), dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      , pdetail(log.details(),
+                dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       , statistics(statistics_columns(dim))
       , timings(timing_columns())
       , triangulation(comm,
@@ -242,7 +261,9 @@ namespace ImmersedGrains
       write_fields_every     = prm.get_integer("Write fields every");
       const std::string mode = prm.get("Terminal output");
       test_output            = mode == "test";
-      quiet                  = mode != "normal";
+      quiet                  = mode != "normal" && mode != "verbose";
+      verbose                = mode == "verbose";
+      progress_interval      = prm.get_double("Progress every seconds");
       test_columns =
         dealii::Utilities::split_string_list(prm.get("Test columns"));
       for (const auto &c : test_columns)
@@ -284,6 +305,13 @@ namespace ImmersedGrains
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);
     load_balance_parameters.parse_parameters(prm, file);
     checkpoint_parameters.parse_parameters(prm, file);
+    cloud_parameters.parse_parameters(prm, file, grain_parameters);
+    if (cloud_parameters.enabled)
+    {
+      cloud_analysis =
+        std::make_unique<CloudAnalysis<dim>>(cloud_parameters, comm);
+      statistics.set("breakup_time", -1); // not yet
+    }
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
     for (const auto &seed : grain_seeds)
@@ -335,7 +363,8 @@ namespace ImmersedGrains
         std::filesystem::copy_options::overwrite_existing);
     }
     MPI_Barrier(comm);
-    log.open(output_directory + "/log.txt", root, !quiet, resumed_step >= 0);
+    log.open(
+      output_directory + "/log.txt", root, !quiet, verbose, resumed_step >= 0);
     statistics.open(output_directory + "/statistics.csv", root, resumed_step);
     timings.open(output_directory + "/timings.csv", root, resumed_step);
     field_output = std::make_unique<FieldOutput<dim>>(output_directory, comm);
@@ -379,7 +408,7 @@ namespace ImmersedGrains
     if (fluid_parameters.enabled)
     {
       fluid = std::make_unique<FluidSolver<dim>>(
-        fluid_parameters, geometry, triangulation, *timer, pcout);
+        fluid_parameters, geometry, triangulation, *timer, pdetail);
       fluid->setup_dofs();
       if (resumed)
         fluid->deserialize();
@@ -438,6 +467,14 @@ namespace ImmersedGrains
                   (coupling_parameters.two_way ? ", two-way" : ", one-way"))
             << '\n';
     }
+    if (cloud_analysis)
+      pcout << "  cloud analysis: clusters of grains closer than "
+            << cloud_parameters.link_distance << " diameters, grown from "
+            << "grains with at least " << cloud_parameters.core_neighbours
+            << " such neighbours; break-up at "
+            << cloud_parameters.placed_clouds + 1 << " clusters of "
+            << cloud_parameters.minimum_cluster_fraction * 100
+            << " % of the grains\n";
 
     // Grains make cells unequal work; on one rank there is nothing to
     // balance.
@@ -494,13 +531,13 @@ namespace ImmersedGrains
     }
     change_mesh([this]()
                 { triangulation.execute_coarsening_and_refinement(); });
-    pcout << "  mesh adapted before step " << step + 1 << ": "
-          << triangulation.n_global_active_cells() << " cells, "
-          << (fluid ? fluid->n_dofs() : 0) << " fluid DoFs, "
-          << std::setprecision(3) << now() - start << " s";
+    pdetail << "  mesh adapted before step " << step + 1 << ": "
+            << triangulation.n_global_active_cells() << " cells, "
+            << (fluid ? fluid->n_dofs() : 0) << " fluid DoFs, "
+            << std::setprecision(3) << now() - start << " s";
     if (load_balance)
-      pcout << ", load imbalance " << load_balance->imbalance();
-    pcout << '\n' << std::setprecision(6);
+      pdetail << ", load imbalance " << load_balance->imbalance();
+    pdetail << '\n' << std::setprecision(6);
     return true;
   }
 
@@ -546,10 +583,10 @@ namespace ImmersedGrains
     if (before <= load_balance_parameters.max_imbalance)
       return;
     change_mesh([this]() { triangulation.repartition(); });
-    pcout << "  mesh repartitioned before step " << step + 1
-          << ": load imbalance " << std::setprecision(3) << before << " -> "
-          << load_balance->imbalance() << '\n'
-          << std::setprecision(6);
+    pdetail << "  mesh repartitioned before step " << step + 1
+            << ": load imbalance " << std::setprecision(3) << before << " -> "
+            << load_balance->imbalance() << '\n'
+            << std::setprecision(6);
   }
 
 
@@ -595,6 +632,7 @@ namespace ImmersedGrains
     // differently from here on. (The preconditioner is rebuilt too.)
     const bool echo = pcout.is_active();
     pcout.set_condition(false);
+    pdetail.set_condition(false);
     coupling.reset();
     adaptivity.reset();
     load_balance.reset();
@@ -603,6 +641,7 @@ namespace ImmersedGrains
     triangulation.clear();
     setup(saved);
     pcout.set_condition(echo);
+    pdetail.set_condition(echo);
   }
 
 
@@ -721,6 +760,8 @@ namespace ImmersedGrains
       comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times);
     prepare_output_directory(resumed_step);
     setup(resume_from);
+    start_time         = time;
+    last_progress_wall = now();
     if (resume_from.empty())
     {
       postprocess(0, 0);
@@ -754,8 +795,9 @@ namespace ImmersedGrains
     if (test_output && dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       print_test_checks(std::cout, test_checks, statistics);
 
+    print_progress(true);
     pcout << "  done: " << step << " steps, wall time " << now() - wall_start
-          << " s\n";
+          << " s; output in " << output_directory << "/\n";
     timer->print_wall_time_statistics(comm);
   }
 
@@ -962,18 +1004,60 @@ namespace ImmersedGrains
     statistics.write_row();
 
     print_test_row(false);
-    if (!quiet)
-    {
-      pcout << "step " << step << " t=" << time << " dt=" << dt;
-      if (fluid)
-        pcout << " fluid iterations=" << fluid_iterations;
-      if (grains)
-        pcout << " grains=" << statistics.get("particles")
+    pdetail << "step " << step << " t=" << time << " dt=" << dt;
+    if (fluid)
+      pdetail << " fluid iterations=" << fluid_iterations;
+    if (grains)
+      pdetail << " grains=" << statistics.get("particles")
               << " contacts=" << statistics.get("contacts")
               << " sweeps=" << statistics.get("contact_iterations")
               << " Ekin=" << statistics.get("kinetic_energy");
-      pcout << '\n';
-    }
+    pdetail << '\n';
+    print_progress(false);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::print_progress(const bool last)
+  {
+    if (quiet || verbose || dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    const double wall     = now();
+    const double interval = log.on_terminal() ? 0.25 : progress_interval;
+    if (!last && (interval <= 0 || wall - last_progress_wall < interval))
+      return;
+    if (last && !log.on_terminal() && wall - last_progress_wall < 1)
+      return; // the last line written is recent enough
+    last_progress_wall = wall;
+
+    // The remaining wall time, from the pace of this run so far.
+    const double       done    = time - start_time;
+    const double       elapsed = wall - wall_start;
+    std::ostringstream line;
+    line << std::setprecision(3) << "t = " << time << " / " << end_time
+         << " s, step " << step;
+    if (fluid)
+      line << " (dt " << statistics.get("dt");
+    if (fluid && grains)
+      line << ", " << static_cast<long long>(statistics.get("grain_substeps"))
+           << " grain sub-steps";
+    if (fluid)
+      line << ")";
+    // Counts as integers (a double stream would write 1.04e+03).
+    const auto count = [this](const char *column)
+    { return static_cast<long long>(statistics.get(column)); };
+    if (grains)
+      line << ", " << count("particles") << " grains";
+    line << ", " << count("cells") << " cells";
+    if (fluid)
+      line << ", " << count("fluid_iterations") << " fluid its";
+    if (grains && grain_parameters.contacts_enabled)
+      line << ", " << count("contact_iterations") << " sweeps";
+    line << std::fixed << std::setprecision(0) << ", wall " << elapsed << " s";
+    if (!last && done > 0 && end_time > time)
+      line << ", ETA " << elapsed * (end_time - time) / done << " s";
+    log.progress(line.str());
   }
 
 
@@ -1009,6 +1093,39 @@ namespace ImmersedGrains
     statistics.set("kinetic_energy", s.kinetic_energy);
     statistics.set("packing_fraction", s.packing_fraction);
     statistics.set("grains_removed", grains->n_removed());
+    if (cloud_analysis)
+      set_cloud_statistics();
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::set_cloud_statistics()
+  {
+    const CloudMeasures<dim> m =
+      cloud_analysis->analyse(grains->particle_handler(),
+                              grains->layout(),
+                              2 * largest_grain_radius);
+    const char *axes[] = {"x", "y", "z"};
+    statistics.set("cloud_grains", m.n_cloud_grains);
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      statistics.set(std::string("cloud_centroid_") + axes[d], m.centroid[d]);
+      statistics.set(std::string("cloud_velocity_") + axes[d], m.velocity[d]);
+      statistics.set(std::string("cloud_extent_") + axes[d], m.extent[d]);
+    }
+    statistics.set("leaked", m.n_leaked);
+    statistics.set("clusters", m.n_clusters);
+    if (m.n_clusters > cloud_parameters.placed_clouds &&
+        statistics.get("breakup_time") < 0)
+    {
+      statistics.set("breakup_time", time);
+      pcout << "The cloud has broken up at t = " << time << " s (step " << step
+            << "): " << m.n_clusters << " clusters of at least "
+            << cloud_parameters.minimum_cluster_fraction * 100
+            << " % of the grains each, " << m.n_leaked
+            << " grains outside the largest\n";
+    }
   }
 
 

@@ -8,6 +8,7 @@
 
 #include <immersed_grains/coupling/coupling.h>
 #include <immersed_grains/fluid/fluid_parameters.h>
+#include <immersed_grains/grains/cloud_analysis.h>
 #include <immersed_grains/grains/grain_parameters.h>
 #include <immersed_grains/grains/placement.h>
 #include <immersed_grains/io/checkpoint.h>
@@ -101,8 +102,15 @@ namespace ImmersedGrains
     postprocess(double dt, unsigned int fluid_iterations);
     void
     set_grain_statistics();
+    /** The cloud columns (Cloud analysis), and the break-up time once. */
+    void
+    set_cloud_statistics();
     void
     maybe_write_fields(bool force);
+    /** The progress line, at most every Progress every seconds (a quarter
+     *  of a second on a terminal); @p last: the run's last one. */
+    void
+    print_progress(bool last);
     void
     print_test_row(bool last) const;
     // One row of timings.csv: the wall time of each phase since the last.
@@ -121,6 +129,10 @@ namespace ImmersedGrains
     unsigned int                    write_fields_every = 0;
     bool                            test_output        = false;
     bool                            quiet              = false;
+    bool                            verbose            = false;
+    double                          progress_interval  = 10;
+    double                          last_progress_wall = 0;
+    double                          start_time         = 0;
     std::vector<std::string>        test_columns;
     unsigned int                    test_every = 1;
     std::vector<TestCheck>          test_checks;
@@ -129,14 +141,15 @@ namespace ImmersedGrains
     unsigned int                    clamped_nodes_before  = 0;
     unsigned int                    preconditioner_builds = 0;
 
-    Geometry<dim>                         geometry;
-    FluidParameters<dim>                  fluid_parameters;
-    GrainParameters<dim>                  grain_parameters;
-    typename Coupling<dim>::Parameters    coupling_parameters;
-    typename Adaptivity<dim>::Parameters  adaptivity_parameters;
-    typename LoadBalance<dim>::Parameters load_balance_parameters;
-    Checkpoint::Parameters                checkpoint_parameters;
-    double                                largest_grain_radius = 0;
+    Geometry<dim>                           geometry;
+    FluidParameters<dim>                    fluid_parameters;
+    GrainParameters<dim>                    grain_parameters;
+    typename Coupling<dim>::Parameters      coupling_parameters;
+    typename Adaptivity<dim>::Parameters    adaptivity_parameters;
+    typename LoadBalance<dim>::Parameters   load_balance_parameters;
+    Checkpoint::Parameters                  checkpoint_parameters;
+    typename CloudAnalysis<dim>::Parameters cloud_parameters;
+    double                                  largest_grain_radius = 0;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
     SizeEstimate                size_estimate;
@@ -144,6 +157,7 @@ namespace ImmersedGrains
 
     RunLog                               log;
     dealii::ConditionalOStream           pcout;
+    dealii::ConditionalOStream           pdetail;
     std::unique_ptr<dealii::TimerOutput> timer;
     Statistics                           statistics;
     Statistics                           timings;
@@ -157,6 +171,7 @@ namespace ImmersedGrains
     std::unique_ptr<Adaptivity<dim>>                  adaptivity;
     std::unique_ptr<LoadBalance<dim>>                 load_balance;
     std::unique_ptr<Checkpoint>                       checkpoint;
+    std::unique_ptr<CloudAnalysis<dim>>               cloud_analysis;
 
     double       time = 0;
     unsigned int step = 0;

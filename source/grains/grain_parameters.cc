@@ -75,7 +75,10 @@ namespace ImmersedGrains
         prm.declare_entry("Center",
                           dim == 2 ? "0.5, 0.5" : "0.5, 0.5, 0.5",
                           Anything(),
-                          "Centre of the ball or box (comma list) [m].");
+                          "Centre of the ball or box (comma list) [m]. For a "
+                          "ball or a box, several centres separated by ';' "
+                          "fill one region around each, alike (e.g. two "
+                          "clouds); the regions must not overlap.");
         prm.declare_entry("Size",
                           "0.25",
                           Anything(),
@@ -328,7 +331,17 @@ namespace ImmersedGrains
                                  s == "file"    ? PlacementShape::file :
                                  s == "lattice" ? PlacementShape::lattice :
                                                   PlacementShape::list);
-        center    = parse_point<dim>(prm.get("Center"), place, "Center");
+        center_text           = prm.get("Center");
+        centers = parse_point_list<dim>(center_text, place, "Center");
+        place.require(!centers.empty() &&
+                        (centers.size() == 1 || shape == PlacementShape::ball ||
+                         shape == PlacementShape::box),
+                      "Center",
+                      prm.get("Center"),
+                      centers.empty() ? "needs a point" :
+                                        "several centres (';') need Shape = "
+                                        "ball or box");
+        center    = centers[0];
         size_text = prm.get("Size");
         size      = parse_double_list(size_text, place, "Size");
         if (shape == PlacementShape::ball)

@@ -535,9 +535,17 @@ namespace ImmersedGrains
     {
       case PlacementShape::ball:
       case PlacementShape::box:
-        grains    = random_fill(prm, random);
-        parameter = "Size";
-        value     = prm.size_text;
+        // One region per centre, filled in turn from the same random
+        // stream.
+        for (const Point<dim> &c : prm.centers)
+        {
+          GrainParameters<dim> region = prm;
+          region.center               = c;
+          for (const auto &g : random_fill(region, random))
+            grains.push_back(g);
+        }
+        parameter = prm.centers.size() > 1 ? "Center" : "Size";
+        value     = prm.centers.size() > 1 ? prm.center_text : prm.size_text;
         break;
       case PlacementShape::lattice:
         grains    = lattice_fill(prm, random);
@@ -588,7 +596,9 @@ namespace ImmersedGrains
     if (grains.empty())
       return grains;
     check_inside(grains, geometry, place, parameter, value);
-    if (prm.shape != PlacementShape::ball && prm.shape != PlacementShape::box)
+    if ((prm.shape != PlacementShape::ball &&
+         prm.shape != PlacementShape::box) ||
+        prm.centers.size() > 1)
       check_overlaps(grains, geometry, place, parameter, value);
     return grains;
   }

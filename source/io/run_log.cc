@@ -2,12 +2,15 @@
 
 #include <immersed_grains/io/run_log.h>
 
+#include <unistd.h>
+
 #include <iostream>
 
 namespace ImmersedGrains
 {
   RunLog::RunLog()
       : out(&buffer)
+      , detail_out(&detail_buffer)
   {
   }
 
@@ -15,6 +18,9 @@ namespace ImmersedGrains
   RunLog::~RunLog()
   {
     out.flush();
+    detail_out.flush();
+    if (progress_pending)
+      std::cout << std::endl;
   }
 
 
@@ -22,14 +28,20 @@ namespace ImmersedGrains
   RunLog::open(const std::string &file_name,
                const bool         is_root,
                const bool         echo,
+               const bool         echo_details,
                const bool         append)
   {
     if (!is_root)
       return;
     file.open(file_name, append ? std::ios::app : std::ios::out);
     AssertThrow(file, dealii::ExcMessage("Cannot write " + file_name));
-    buffer.first  = file.rdbuf();
-    buffer.second = echo ? std::cout.rdbuf() : nullptr;
+    terminal             = echo && isatty(STDOUT_FILENO);
+    buffer.first         = file.rdbuf();
+    buffer.second        = echo ? std::cout.rdbuf() : nullptr;
+    detail_buffer.first  = file.rdbuf();
+    detail_buffer.second = echo && echo_details ? std::cout.rdbuf() : nullptr;
+    buffer.progress_pending        = &progress_pending;
+    detail_buffer.progress_pending = &progress_pending;
   }
 
 
@@ -37,6 +49,31 @@ namespace ImmersedGrains
   RunLog::stream()
   {
     return out;
+  }
+
+
+  std::ostream &
+  RunLog::details()
+  {
+    return detail_out;
+  }
+
+
+  void
+  RunLog::progress(const std::string &line)
+  {
+    if (!buffer.second)
+      return;
+    out.flush();
+    detail_out.flush();
+    if (terminal)
+    {
+      // Back to the start of the line, the new text, the rest cleared.
+      std::cout << '\r' << line << "\033[K" << std::flush;
+      progress_pending = true;
+    }
+    else
+      std::cout << line << std::endl;
   }
 
 
@@ -48,7 +85,14 @@ namespace ImmersedGrains
     if (first)
       first->sputc(static_cast<char>(c));
     if (second)
+    {
+      if (progress_pending && *progress_pending)
+      {
+        second->sputc('\n');
+        *progress_pending = false;
+      }
       second->sputc(static_cast<char>(c));
+    }
     return c;
   }
 

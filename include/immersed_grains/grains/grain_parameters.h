@@ -71,7 +71,8 @@ namespace ImmersedGrains
 
     // Grains/Placement
     PlacementShape                  shape = PlacementShape::list;
-    dealii::Point<dim>              center;
+    dealii::Point<dim>              center; // the first of centers
+    std::vector<dealii::Point<dim>> centers;
     std::vector<double>             size; // ball: 1 value; box: dim values
     double                          solid_fraction = 0.3;
     unsigned int                    count          = 0;
@@ -81,7 +82,7 @@ namespace ImmersedGrains
     std::string                     placement_file;
     // The entry texts, for messages naming them.
     std::string size_text, solid_fraction_text, count_text, positions_text,
-      velocities_text;
+      velocities_text, center_text;
 
     // Contacts
     bool                       contacts_enabled = true;

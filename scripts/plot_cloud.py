@@ -1,0 +1,307 @@
+#!/usr/bin/env python3
+"""Figures of a falling-cloud run (2D) from its output directory:
+
+    /usr/bin/python3 scripts/plot_cloud.py OUTPUT_DIR [--out-prefix P]
+        [--stages t1,t2,t3,t4,t5] [--flow t1,t2] [--half-width W]
+        [--groups N]
+
+writes
+  P_stages.png  the grains at five instants side by side, each framed on
+                the cloud's centroid (by default the start, half the
+                break-up time, the break-up, a third of the way from there
+                to the end, and the end; without a break-up five instants
+                evenly spaced);
+  P_flow.png    at two instants: the pressure less its hydrostatic part
+                (colour) and the streamlines of the fluid velocity, with the
+                grains on top (by default the middle of the run and just
+                after the break-up, or its end);
+  P_series.png  from statistics.csv: the cloud's velocity, its extent per
+                axis, the leaked grains and the number of clusters, the
+                break-up time marked.
+
+  P_groups.png  with --groups N (N clouds placed one after another): each
+                cloud's fall velocity and the vertical distance between
+                consecutive clouds' centroids; the stages colour each.
+
+P defaults to OUTPUT_DIR/cloud. Needs the Cloud analysis columns (on by
+default for a ball of grains) and fields written at the chosen instants
+(Output/Write fields every); each instant is taken as the nearest written
+state. Reads the VTU files directly (scripts/plot_scene.py's reader).
+"""
+import argparse
+import csv
+import os
+import re
+import sys
+
+import numpy as np
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.tri as mtri  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plot_scene import read_vtu  # noqa: E402
+
+
+def read_statistics(directory):
+    path = os.path.join(directory, "statistics.csv")
+    if not os.path.exists(path):
+        sys.exit("plot_cloud.py: no statistics.csv in %s" % directory)
+    rows = list(csv.DictReader(open(path)))
+    if not rows or "cloud_centroid_x" not in rows[0]:
+        sys.exit("plot_cloud.py: %s has no cloud columns (Cloud analysis)"
+                 % path)
+    if "cloud_centroid_z" in rows[0]:
+        sys.exit("plot_cloud.py: draws 2D runs only")
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def written_states(directory, prefix):
+    """(time, [piece files]) per state in PREFIX.pvd."""
+    pvd = os.path.join(directory, prefix + ".pvd")
+    if not os.path.exists(pvd):
+        sys.exit("plot_cloud.py: no %s" % pvd)
+    states = []
+    for t, name in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"',
+                              open(pvd).read()):
+        master = os.path.join(directory, name)
+        if name.endswith(".pvtu"):
+            pieces = [os.path.join(directory, p) for p in re.findall(
+                r'Piece Source="([^"]+)"', open(master).read())]
+        else:
+            pieces = [master]
+        states.append((float(t), pieces))
+    if not states:
+        sys.exit("plot_cloud.py: %s lists no states" % pvd)
+    return states
+
+
+def nearest(states, t):
+    return min(states, key=lambda s: abs(s[0] - t))
+
+
+def grains_at(pieces, with_ids=False):
+    points, ids = [], []
+    for path in pieces:
+        x, arrays, _ = read_vtu(path)
+        if len(x):
+            points.append(x[:, :2])
+            ids.append(arrays["id"].astype(np.int64))
+    x = np.concatenate(points) if points else np.zeros((0, 2))
+    if with_ids:
+        return x, (np.concatenate(ids) if ids else np.zeros(0, np.int64))
+    return x
+
+
+def group_of(ids, n_grains, groups):
+    """Clouds placed one after another (Grains/Placement/Center with
+    several centres) have consecutive ids: group k holds the k-th share."""
+    return np.minimum(ids * groups // max(n_grains, 1), groups - 1)
+
+
+def fields_at(pieces):
+    xs, ps, vs = [], [], []
+    for path in pieces:
+        points, arrays, _ = read_vtu(path)
+        xs.append(points[:, :2])
+        ps.append(arrays["pressure"])
+        vs.append(arrays["velocity"][:, :2])
+    x, p, v = np.concatenate(xs), np.concatenate(ps), np.concatenate(vs)
+    # deal.II writes each cell's nodes apart: merge coincident points.
+    key = np.round(x / (1e-9 * np.ptp(x, axis=0).max()))
+    _, unique = np.unique(key, axis=0, return_index=True)
+    return x[unique], p[unique], v[unique]
+
+
+def centroid_at(stats, t):
+    return (np.interp(t, stats["time"], stats["cloud_centroid_x"]),
+            np.interp(t, stats["time"], stats["cloud_centroid_y"]))
+
+
+def frame(axes, centre, half_width):
+    axes.set_xlim(centre[0] - half_width, centre[0] + half_width)
+    axes.set_ylim(centre[1] - half_width, centre[1] + half_width)
+    axes.set_aspect("equal")
+    axes.set_xticks([])
+    axes.set_yticks([])
+
+
+def plot_stages(directory, stats, times, half_width, out, groups):
+    particles = written_states(directory, "particles")
+    n_grains = int(stats["particles"][0])
+    figure, panels = plt.subplots(1, len(times),
+                                  figsize=(2.6 * len(times), 3.0))
+    for axes, t in zip(np.atleast_1d(panels), times):
+        t_state, pieces = nearest(particles, t)
+        x, ids = grains_at(pieces, with_ids=True)
+        centre = centroid_at(stats, t_state)
+        colour = ("k" if groups == 1 else
+                  np.array(["k", "tab:red", "tab:blue", "tab:green"])[
+                      group_of(ids, n_grains, groups) % 4])
+        axes.scatter(x[:, 0], x[:, 1], s=1.2, c=colour, edgecolors="none")
+        frame(axes, centre, half_width)
+        axes.set_title("t = %.3g s" % t_state, fontsize=10)
+    np.atleast_1d(panels)[0].set_ylabel("%.2g mm frames on the centroid"
+                                        % (2e3 * half_width), fontsize=8)
+    figure.tight_layout()
+    figure.savefig(out, dpi=150)
+    plt.close(figure)
+    print(out)
+
+
+def plot_flow(directory, stats, times, half_width, out):
+    fields = written_states(directory, "fields")
+    particles = written_states(directory, "particles")
+    figure, panels = plt.subplots(1, len(times),
+                                  figsize=(4.6 * len(times), 4.2))
+    for axes, t in zip(np.atleast_1d(panels), times):
+        t_state, pieces = nearest(fields, t)
+        x, p, v = fields_at(pieces)
+        # The hydrostatic part: the least-squares plane of the pressure
+        # over the whole domain (the mixture's mean weight).
+        basis = np.column_stack([np.ones(len(x)), x[:, 0], x[:, 1]])
+        coefficients = np.linalg.lstsq(basis, p, rcond=None)[0]
+        excess = p - basis @ coefficients
+        centre = centroid_at(stats, t_state)
+        triangulation = mtri.Triangulation(x[:, 0], x[:, 1])
+        n = 120
+        gx = np.linspace(centre[0] - half_width, centre[0] + half_width, n)
+        gy = np.linspace(centre[1] - half_width, centre[1] + half_width, n)
+        X, Y = np.meshgrid(gx, gy)
+        grid = [mtri.LinearTriInterpolator(triangulation, f)(X, Y)
+                for f in (excess, v[:, 0], v[:, 1])]
+        limit = np.nanmax(np.abs(grid[0]))
+        image = axes.pcolormesh(X, Y, grid[0], cmap="RdBu_r",
+                                vmin=-limit, vmax=limit, shading="auto")
+        figure.colorbar(image, ax=axes, label="pressure - hydrostatic [Pa]",
+                        shrink=0.8)
+        axes.streamplot(gx, gy, np.ma.filled(grid[1], 0.),
+                        np.ma.filled(grid[2], 0.), color="0.25",
+                        density=1.2, linewidth=0.6, arrowsize=0.6)
+        g = grains_at(nearest(particles, t_state)[1])
+        axes.scatter(g[:, 0], g[:, 1], s=0.8, c="k", edgecolors="none")
+        frame(axes, centre, half_width)
+        axes.set_title("t = %.3g s" % t_state, fontsize=10)
+    figure.tight_layout()
+    figure.savefig(out, dpi=150)
+    plt.close(figure)
+    print(out)
+
+
+def plot_series(stats, out):
+    t = stats["time"]
+    breakup = stats["breakup_time"][-1]
+    figure, panels = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
+    panels[0, 0].plot(t, -stats["cloud_velocity_y"] * 1e3)
+    panels[0, 0].set_ylabel("cloud fall velocity [mm/s]")
+    panels[0, 1].plot(t, stats["cloud_extent_x"] * 1e3, label="horizontal")
+    panels[0, 1].plot(t, stats["cloud_extent_y"] * 1e3, label="vertical")
+    panels[0, 1].set_ylabel("radius of gyration [mm]")
+    panels[0, 1].legend(fontsize=8)
+    panels[1, 0].plot(t, stats["leaked"], label="outside the largest cluster")
+    panels[1, 0].plot(t, stats["particles"] - stats["cloud_grains"],
+                      label="in the loose tail")
+    panels[1, 0].set_ylabel("grains")
+    panels[1, 0].legend(fontsize=8)
+    panels[1, 1].step(t, stats["clusters"], where="post")
+    panels[1, 1].set_ylabel("clusters")
+    for axes in panels.flat:
+        if breakup >= 0:
+            axes.axvline(breakup, color="r", lw=0.8, ls="--")
+        axes.grid(alpha=0.3)
+    for axes in panels[1]:
+        axes.set_xlabel("t [s]")
+    title = "break-up at t = %.3g s" % breakup if breakup >= 0 else \
+        "no break-up"
+    figure.suptitle(title, fontsize=10)
+    figure.tight_layout()
+    figure.savefig(out, dpi=150)
+    plt.close(figure)
+    print(out)
+
+
+def plot_groups(directory, stats, groups, out):
+    """Each placed cloud's centroid height and fall velocity, and the
+    vertical distance between consecutive clouds, from the particle
+    files (every written state)."""
+    particles = written_states(directory, "particles")
+    n_grains = int(stats["particles"][0])
+    times, heights = [], []
+    for t, pieces in particles:
+        x, ids = grains_at(pieces, with_ids=True)
+        g = group_of(ids, n_grains, groups)
+        times.append(t)
+        heights.append([x[g == k, 1].mean() for k in range(groups)])
+    times, heights = np.array(times), np.array(heights)
+    figure, panels = plt.subplots(1, 2, figsize=(9, 3.4))
+    colours = ["k", "tab:red", "tab:blue", "tab:green"]
+    for k in range(groups):
+        velocity = -np.gradient(heights[:, k], times)
+        panels[0].plot(times, velocity * 1e3, color=colours[k % 4],
+                       label="cloud %d" % (k + 1))
+    panels[0].set_ylabel("fall velocity of each cloud's grains [mm/s]")
+    panels[0].legend(fontsize=8)
+    for k in range(groups - 1):
+        panels[1].plot(times, (heights[:, k + 1] - heights[:, k]) * 1e3,
+                       color=colours[(k + 1) % 4],
+                       label="cloud %d above cloud %d" % (k + 2, k + 1))
+    panels[1].axhline(0, color="0.5", lw=0.8)
+    panels[1].set_ylabel("vertical distance between centroids [mm]")
+    panels[1].legend(fontsize=8)
+    for axes in panels:
+        axes.set_xlabel("t [s]")
+        axes.grid(alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(out, dpi=150)
+    plt.close(figure)
+    print(out)
+
+
+def times_option(text, count, name):
+    if text is None:
+        return None
+    values = [float(v) for v in text.split(",")]
+    if len(values) != count:
+        sys.exit("plot_cloud.py: %s needs %d times" % (name, count))
+    return values
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("directory")
+    parser.add_argument("--out-prefix")
+    parser.add_argument("--stages", help="five times, comma separated")
+    parser.add_argument("--flow", help="two times, comma separated")
+    parser.add_argument("--groups", type=int, default=1,
+                        help="clouds placed one after another (several "
+                        "Grains/Placement/Center): colour each and write "
+                        "P_groups.png with their heights and velocities")
+    parser.add_argument("--half-width", type=float,
+                        help="half the side of each frame [m] (default: "
+                        "six times the cloud's initial radius of gyration)")
+    args = parser.parse_args()
+
+    stats = read_statistics(args.directory)
+    prefix = args.out_prefix or os.path.join(args.directory, "cloud")
+    end = stats["time"][-1]
+    breakup = stats["breakup_time"][-1]
+    half_width = args.half_width or 6 * max(stats["cloud_extent_x"][0],
+                                            stats["cloud_extent_y"][0])
+    default_stages = [0, breakup / 2, breakup, breakup + (end - breakup) / 3,
+                      end] if breakup > 0 else list(np.linspace(0, end, 5))
+    stages = times_option(args.stages, 5, "--stages") or default_stages
+    flow = times_option(args.flow, 2, "--flow") or \
+        [0.5 * (breakup if breakup > 0 else end),
+         min(end, 1.2 * breakup) if breakup > 0 else end]
+    plot_stages(args.directory, stats, stages, half_width,
+                prefix + "_stages.png", args.groups)
+    plot_flow(args.directory, stats, flow, half_width, prefix + "_flow.png")
+    plot_series(stats, prefix + "_series.png")
+    if args.groups > 1:
+        plot_groups(args.directory, stats, args.groups, prefix + "_groups.png")
+
+
+if __name__ == "__main__":
+    main()
