@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <iostream>
 
 namespace ImmersedGrains
@@ -35,7 +36,12 @@ namespace ImmersedGrains
       return;
     file.open(file_name, append ? std::ios::app : std::ios::out);
     AssertThrow(file, dealii::ExcMessage("Cannot write " + file_name));
-    terminal             = echo && isatty(STDOUT_FILENO);
+    // mpirun hands its ranks a pseudo-terminal whatever its own output
+    // is (often a file): under an MPI launcher, a line at a time.
+    const bool launched_by_mpi = std::getenv("OMPI_COMM_WORLD_SIZE") ||
+                                 std::getenv("PMI_SIZE") ||
+                                 std::getenv("PMIX_RANK");
+    terminal             = echo && isatty(STDOUT_FILENO) && !launched_by_mpi;
     buffer.first         = file.rdbuf();
     buffer.second        = echo ? std::cout.rdbuf() : nullptr;
     detail_buffer.first  = file.rdbuf();
