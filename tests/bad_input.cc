@@ -237,6 +237,24 @@ end
              "heavy\nend\n",
          "Grain weight",
          "heavy"},
+        {"cloud_analysis_without_grains",
+         "set Dimension = 2\nsubsection Cloud analysis\n set Enabled = "
+             "true\nend\n",
+         "Enabled",
+         "true"},
+        {"several_centres_for_a_lattice",
+         "set Dimension = 2\nsubsection Grains\n set Enabled = true\n set "
+             "Radius = 0.01\n subsection Placement\n  set Shape = lattice\n"
+             "  set Center = 0.3, 0.3; 0.7, 0.7\n  set Size = 0.2\n end\nend\n",
+         "Center",
+         "0.3, 0.3; 0.7, 0.7"},
+        {"overlapping_clouds",
+         "set Dimension = 2\nsubsection Grains\n set Enabled = true\n set "
+             "Radius = 0.01\n subsection Placement\n  set Shape = ball\n"
+             "  set Center = 0.4, 0.5; 0.5, 0.5\n  set Size = 0.2\n"
+             "  set Solid fraction = 0.4\n end\nend\n",
+         "Center",
+         "0.4, 0.5; 0.5, 0.5"},
   };
 
   unsigned int failures = 0;
