@@ -162,8 +162,17 @@ namespace ImmersedGrains
       prm.declare_entry("Write fields every",
                         "0",
                         Integer(0),
-                        "Write VTU/PVTU fields every this many steps (0: only "
-                        "the initial and the final state).");
+                        "Write the fields and the grains every this many "
+                        "steps (0: only the initial and the final state).");
+      prm.declare_entry(
+        "Format",
+        "vtu",
+        Selection("vtu|hdf5"),
+        "vtu: a VTU piece per rank and time with a PVTU record, listed in "
+        "fields.pvd and particles.pvd; hdf5: one HDF5 file per time written "
+        "by all ranks together, listed in fields.xdmf and particles.xdmf "
+        "(for runs with many ranks or large meshes: two files per output "
+        "whatever the number of ranks). ParaView opens both.");
       prm.declare_entry("Terminal output",
                         "normal",
                         Selection("normal|verbose|quiet|test"),
@@ -258,7 +267,9 @@ namespace ImmersedGrains
     prm.enter_subsection("Output");
     {
       const InputLocation where{file, "Output"};
-      write_fields_every     = prm.get_integer("Write fields every");
+      write_fields_every = prm.get_integer("Write fields every");
+      output_format =
+        prm.get("Format") == "hdf5" ? OutputFormat::hdf5 : OutputFormat::vtu;
       const std::string mode = prm.get("Terminal output");
       test_output            = mode == "test";
       quiet                  = mode != "normal" && mode != "verbose";
@@ -367,9 +378,11 @@ namespace ImmersedGrains
       output_directory + "/log.txt", root, !quiet, verbose, resumed_step >= 0);
     statistics.open(output_directory + "/statistics.csv", root, resumed_step);
     timings.open(output_directory + "/timings.csv", root, resumed_step);
-    field_output = std::make_unique<FieldOutput<dim>>(output_directory, comm);
-    particle_output =
-      std::make_unique<ParticleOutput<dim>>(output_directory, comm);
+    field_output =
+      std::make_unique<FieldOutput<dim>>(output_directory, output_format, comm);
+    particle_output = std::make_unique<ParticleOutput<dim>>(output_directory,
+                                                            output_format,
+                                                            comm);
   }
 
 
@@ -621,6 +634,8 @@ namespace ImmersedGrains
       grains->save_contact_memory(out);
       AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
     }
+    field_output->series().save(directory + "/fields_xdmf.txt");
+    particle_output->series().save(directory + "/particles_xdmf.txt");
     // Written last: its presence marks the set complete (Checkpoint).
     save_state(directory);
     const std::string saved = checkpoint->commit(step, now());
@@ -661,8 +676,8 @@ namespace ImmersedGrains
       fluid->save_state(out);
     else
       out << "none\n";
-    for (const auto *records :
-         {&field_output->pvd_records(), &particle_output->pvd_records()})
+    for (const auto *records : {&field_output->series().records(),
+                                &particle_output->series().records()})
     {
       out << records->size() << '\n';
       for (const auto &[t, file] : *records)
@@ -691,8 +706,8 @@ namespace ImmersedGrains
       fluid->load_state(in);
     else
       in >> text;
-    for (auto *records :
-         {&field_output->pvd_records(), &particle_output->pvd_records()})
+    for (auto *records : {&field_output->series().records(),
+                          &particle_output->series().records()})
     {
       std::size_t n = 0;
       in >> n;
@@ -707,6 +722,8 @@ namespace ImmersedGrains
     statistics.load_values(in);
     AssertThrow(!in.bad(),
                 dealii::ExcMessage("Checkpoint: cannot read " + directory));
+    field_output->series().load(directory + "/fields_xdmf.txt");
+    particle_output->series().load(directory + "/particles_xdmf.txt");
 
     if (grains)
     {

@@ -12,6 +12,7 @@
 #include <immersed_grains/grains/grain_parameters.h>
 #include <immersed_grains/grains/placement.h>
 #include <immersed_grains/io/checkpoint.h>
+#include <immersed_grains/io/output_series.h>
 #include <immersed_grains/io/run_log.h>
 #include <immersed_grains/io/statistics.h>
 #include <immersed_grains/io/test_checks.h>
@@ -127,6 +128,7 @@ namespace ImmersedGrains
     double      shortest_cell_edge = 0;
 
     unsigned int                    write_fields_every = 0;
+    OutputFormat                    output_format      = OutputFormat::vtu;
     bool                            test_output        = false;
     bool                            quiet              = false;
     bool                            verbose            = false;

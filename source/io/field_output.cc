@@ -7,9 +7,10 @@
 namespace ImmersedGrains
 {
   template <int dim>
-  FieldOutput<dim>::FieldOutput(const std::string &directory, MPI_Comm comm)
-      : directory(directory)
-      , comm(comm)
+  FieldOutput<dim>::FieldOutput(const std::string &directory,
+                                const OutputFormat format,
+                                MPI_Comm           comm)
+      : written(directory, "fields", format, comm)
   {
   }
 
@@ -42,16 +43,10 @@ namespace ImmersedGrains
     flags.cycle             = step;
     flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
     data_out.set_flags(flags);
+    // Quadratic cells drawn as 2^dim subcells; XDMF knows linear cells
+    // only, where the subcells are cells of their own.
     data_out.build_patches(2);
-
-    const std::string master = data_out.write_vtu_with_pvtu_record(
-      directory + "/", "fields", step, comm, 5, 8);
-    records.emplace_back(time, master);
-    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-    {
-      std::ofstream pvd(directory + "/fields.pvd");
-      dealii::DataOutBase::write_pvd_record(pvd, records);
-    }
+    written.write(data_out, time, step);
   }
 
 

@@ -9,9 +9,9 @@ namespace ImmersedGrains
 {
   template <int dim>
   ParticleOutput<dim>::ParticleOutput(const std::string &directory,
+                                      const OutputFormat format,
                                       MPI_Comm           comm)
-      : directory(directory)
-      , comm(comm)
+      : written(directory, "particles", format, comm)
   {
   }
 
@@ -36,14 +36,7 @@ namespace ImmersedGrains
     flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
     data_out.set_flags(flags);
 
-    const std::string master = data_out.write_vtu_with_pvtu_record(
-      directory + "/", "particles", step, comm, 5, 8);
-    records.emplace_back(time, master);
-    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-    {
-      std::ofstream pvd(directory + "/particles.pvd");
-      dealii::DataOutBase::write_pvd_record(pvd, records);
-    }
+    written.write(data_out, time, step);
   }
 
 

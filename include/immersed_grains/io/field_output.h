@@ -5,6 +5,8 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/numerics/data_out.h>
 
+#include <immersed_grains/io/output_series.h>
+
 #include <functional>
 #include <string>
 #include <utility>
@@ -13,15 +15,18 @@
 namespace ImmersedGrains
 {
   /**
-   * Writes the fields of one output time as VTU pieces (one per rank) with
-   * a PVTU master and keeps fields.pvd, the time series ParaView opens.
-   * Each piece carries the MPI rank and refinement level as cell data.
+   * Writes the fields of one output time, as VTU pieces (one per rank)
+   * with a PVTU master listed in fields.pvd, or as one HDF5 file listed in
+   * fields.xdmf (Output/Format). Each carries the MPI rank and refinement
+   * level as cell data.
    */
   template <int dim>
   class FieldOutput
   {
   public:
-    FieldOutput(const std::string &directory, MPI_Comm comm);
+    FieldOutput(const std::string &directory,
+                OutputFormat       format,
+                MPI_Comm           comm);
 
     /**
      * @p add_fields attaches the solver's vectors to the DataOut object.
@@ -32,17 +37,15 @@ namespace ImmersedGrains
           unsigned int                                             step,
           const std::function<void(dealii::DataOut<dim> &)>       &add_fields);
 
-    /** The (time, file) records of the PVD file, for a checkpoint. */
-    std::vector<std::pair<double, std::string>> &
-    pvd_records()
+    /** The states written, for a checkpoint. */
+    OutputSeries &
+    series()
     {
-      return records;
+      return written;
     }
 
   private:
-    std::string                                 directory;
-    MPI_Comm                                    comm;
-    std::vector<std::pair<double, std::string>> records;
+    OutputSeries written;
   };
 } // namespace ImmersedGrains
 

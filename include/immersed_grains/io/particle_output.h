@@ -9,19 +9,24 @@
 #include <utility>
 #include <vector>
 
+#include <immersed_grains/io/output_series.h>
+
 namespace ImmersedGrains
 {
   /**
-   * Writes the grains of one output time as VTU pieces (one per rank, one
-   * vertex per grain with its id and properties) with a PVTU master, and
-   * keeps particles.pvd, the time series ParaView opens beside fields.pvd.
+   * Writes the grains of one output time (one vertex per grain with its id
+   * and properties) as VTU pieces with a PVTU master listed in
+   * particles.pvd, or as one HDF5 file listed in particles.xdmf
+   * (Output/Format), the time series ParaView opens beside the fields'.
    * Show them as spheres with the Glyph filter scaled by "radius".
    */
   template <int dim>
   class ParticleOutput
   {
   public:
-    ParticleOutput(const std::string &directory, MPI_Comm comm);
+    ParticleOutput(const std::string &directory,
+                   OutputFormat       format,
+                   MPI_Comm           comm);
 
     void
     write(const dealii::Particles::ParticleHandler<dim> &particles,
@@ -32,17 +37,15 @@ namespace ImmersedGrains
           double       time,
           unsigned int step);
 
-    /** The (time, file) records of the PVD file, for a checkpoint. */
-    std::vector<std::pair<double, std::string>> &
-    pvd_records()
+    /** The states written, for a checkpoint. */
+    OutputSeries &
+    series()
     {
-      return records;
+      return written;
     }
 
   private:
-    std::string                                 directory;
-    MPI_Comm                                    comm;
-    std::vector<std::pair<double, std::string>> records;
+    OutputSeries written;
   };
 } // namespace ImmersedGrains
 
