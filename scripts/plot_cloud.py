@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Figures of a falling-cloud run (2D) from its output directory:
+"""Figures of a falling-cloud run from its output directory (3D runs are
+drawn from the side, x across and z up, and have no flow figure):
 
     /usr/bin/python3 scripts/plot_cloud.py OUTPUT_DIR [--out-prefix P]
         [--stages t1,t2,t3,t4,t5] [--flow t1,t2] [--half-width W]
@@ -53,9 +54,18 @@ def read_statistics(directory):
     if not rows or "cloud_centroid_x" not in rows[0]:
         sys.exit("plot_cloud.py: %s has no cloud columns (Cloud analysis)"
                  % path)
-    if "cloud_centroid_z" in rows[0]:
-        sys.exit("plot_cloud.py: draws 2D runs only")
+    # In 3D the pictures are side views: x across, z (along gravity) up.
+    global VERTICAL
+    VERTICAL = "z" if "cloud_centroid_z" in rows[0] else "y"
     return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+VERTICAL = "y"  # the vertical axis's name, set by read_statistics()
+
+
+def view(points):
+    """The drawn coordinates: (x, y) in 2D, (x, z) in 3D."""
+    return points[:, [0, 2 if VERTICAL == "z" else 1]]
 
 
 def written_states(directory, prefix):
@@ -87,7 +97,7 @@ def grains_at(pieces, with_ids=False):
     for path in pieces:
         x, arrays, _ = read_vtu(path)
         if len(x):
-            points.append(x[:, :2])
+            points.append(view(x))
             ids.append(arrays["id"].astype(np.int64))
     x = np.concatenate(points) if points else np.zeros((0, 2))
     if with_ids:
@@ -117,7 +127,7 @@ def fields_at(pieces):
 
 def centroid_at(stats, t):
     return (np.interp(t, stats["time"], stats["cloud_centroid_x"]),
-            np.interp(t, stats["time"], stats["cloud_centroid_y"]))
+            np.interp(t, stats["time"], stats["cloud_centroid_" + VERTICAL]))
 
 
 def frame(axes, centre, half_width):
@@ -140,7 +150,9 @@ def plot_stages(directory, stats, times, half_width, out, groups):
         colour = ("k" if groups == 1 else
                   np.array(["k", "tab:red", "tab:blue", "tab:green"])[
                       group_of(ids, n_grains, groups) % 4])
-        axes.scatter(x[:, 0], x[:, 1], s=1.2, c=colour, edgecolors="none")
+        axes.scatter(x[:, 0], x[:, 1], s=1.2 if VERTICAL == "y" else 0.3,
+                     c=colour, edgecolors="none",
+                     alpha=1 if VERTICAL == "y" else 0.4)
         frame(axes, centre, half_width)
         axes.set_title("t = %.3g s" % t_state, fontsize=10)
     np.atleast_1d(panels)[0].set_ylabel("%.2g mm frames on the centroid"
@@ -194,10 +206,11 @@ def plot_series(stats, out):
     t = stats["time"]
     breakup = stats["breakup_time"][-1]
     figure, panels = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
-    panels[0, 0].plot(t, -stats["cloud_velocity_y"] * 1e3)
+    panels[0, 0].plot(t, -stats["cloud_velocity_" + VERTICAL] * 1e3)
     panels[0, 0].set_ylabel("cloud fall velocity [mm/s]")
     panels[0, 1].plot(t, stats["cloud_extent_x"] * 1e3, label="horizontal")
-    panels[0, 1].plot(t, stats["cloud_extent_y"] * 1e3, label="vertical")
+    panels[0, 1].plot(t, stats["cloud_extent_" + VERTICAL] * 1e3,
+                      label="vertical")
     panels[0, 1].set_ylabel("radius of gyration [mm]")
     panels[0, 1].legend(fontsize=8)
     panels[1, 0].plot(t, stats["leaked"], label="outside the largest cluster")
@@ -288,7 +301,7 @@ def main():
     end = stats["time"][-1]
     breakup = stats["breakup_time"][-1]
     half_width = args.half_width or 6 * max(stats["cloud_extent_x"][0],
-                                            stats["cloud_extent_y"][0])
+                                            stats["cloud_extent_" + VERTICAL][0])
     default_stages = [0, breakup / 2, breakup, breakup + (end - breakup) / 3,
                       end] if breakup > 0 else list(np.linspace(0, end, 5))
     stages = times_option(args.stages, 5, "--stages") or default_stages
@@ -297,7 +310,11 @@ def main():
          min(end, 1.2 * breakup) if breakup > 0 else end]
     plot_stages(args.directory, stats, stages, half_width,
                 prefix + "_stages.png", args.groups)
-    plot_flow(args.directory, stats, flow, half_width, prefix + "_flow.png")
+    if VERTICAL == "y":
+        plot_flow(args.directory, stats, flow, half_width,
+                  prefix + "_flow.png")
+    else:
+        print("(no flow figure in 3D: open fields.pvd in ParaView)")
     plot_series(stats, prefix + "_series.png")
     if args.groups > 1:
         plot_groups(args.directory, stats, args.groups, prefix + "_groups.png")
