@@ -4,7 +4,7 @@ drawn from the side, x across and z up, and have no flow figure):
 
     /usr/bin/python3 scripts/plot_cloud.py OUTPUT_DIR [--out-prefix P]
         [--stages t1,t2,t3,t4,t5] [--flow t1,t2] [--half-width W]
-        [--groups N]
+        [--groups N] [--reference-velocity U]
 
 writes
   P_stages.png  the grains at five instants side by side, each framed on
@@ -202,11 +202,15 @@ def plot_flow(directory, stats, times, half_width, out):
     print(out)
 
 
-def plot_series(stats, out):
+def plot_series(stats, out, reference=None):
     t = stats["time"]
     breakup = stats["breakup_time"][-1]
     figure, panels = plt.subplots(2, 2, figsize=(9, 6), sharex=True)
     panels[0, 0].plot(t, -stats["cloud_velocity_" + VERTICAL] * 1e3)
+    if reference:
+        panels[0, 0].axhline(reference * 1e3, color="0.4", ls=":",
+                             label="reference %.4g mm/s" % (reference * 1e3))
+        panels[0, 0].legend(fontsize=8)
     panels[0, 0].set_ylabel("cloud fall velocity [mm/s]")
     panels[0, 1].plot(t, stats["cloud_extent_x"] * 1e3, label="horizontal")
     panels[0, 1].plot(t, stats["cloud_extent_" + VERTICAL] * 1e3,
@@ -291,6 +295,9 @@ def main():
                         help="clouds placed one after another (several "
                         "Grains/Placement/Center): colour each and write "
                         "P_groups.png with their heights and velocities")
+    parser.add_argument("--reference-velocity", type=float,
+                        help="a velocity [m/s] to draw beside the cloud's "
+                        "(e.g. the Hadamard-Rybczynski estimate)")
     parser.add_argument("--half-width", type=float,
                         help="half the side of each frame [m] (default: "
                         "six times the cloud's initial radius of gyration)")
@@ -315,7 +322,7 @@ def main():
                   prefix + "_flow.png")
     else:
         print("(no flow figure in 3D: open fields.pvd in ParaView)")
-    plot_series(stats, prefix + "_series.png")
+    plot_series(stats, prefix + "_series.png", args.reference_velocity)
     if args.groups > 1:
         plot_groups(args.directory, stats, args.groups, prefix + "_groups.png")
 
