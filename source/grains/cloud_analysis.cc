@@ -1,13 +1,11 @@
 #include <deal.II/base/mpi.h>
 
+#include <immersed_grains/contact/bucket_grid.h>
 #include <immersed_grains/grains/cloud_analysis.h>
 #include <immersed_grains/grains/grains.h>
 #include <immersed_grains/parameters.h>
 
 #include <algorithm>
-#include <array>
-#include <cmath>
-#include <cstdint>
 #include <numeric>
 #include <unordered_map>
 
@@ -74,13 +72,13 @@ namespace ImmersedGrains
     {
       const InputLocation where{file, "Cloud analysis"};
       const std::string   choice = prm.get("Enabled");
-      enabled                    = choice == "true" ||
-                (choice == "auto" && grains.shape == PlacementShape::ball);
       where.require(!(choice == "true" && !grains.enabled),
                     "Enabled",
                     choice,
                     "needs grains (Grains/Enabled = true)");
-      enabled                  = enabled && grains.enabled;
+      enabled = grains.enabled &&
+                (choice == "true" ||
+                 (choice == "auto" && grains.shape == PlacementShape::ball));
       placed_clouds            = grains.shape == PlacementShape::ball ?
                                    std::max<std::size_t>(1, grains.centers.size()) :
                                    1;
@@ -147,54 +145,25 @@ namespace ImmersedGrains
     if (n == 0)
       return {};
 
-    // Cell lists of edge link_distance: a linked pair lies in the same or
-    // in neighbouring cells.
-    dealii::Point<dim> lower = points[0];
+    // Linked pairs (i < j) from the contacts' bucket grid: spheres of
+    // diameter link_distance that overlap. The box around the points is
+    // widened by a link so that it has a volume with one point, or with
+    // points on a line.
+    dealii::Point<dim> lower = points[0], upper = points[0];
     for (const auto &p : points)
       for (unsigned int d = 0; d < dim; ++d)
-        lower[d] = std::min(lower[d], p[d]);
-    auto cell_of = [&](const dealii::Point<dim> &p)
-    {
-      std::array<std::int64_t, dim> c;
-      for (unsigned int d = 0; d < dim; ++d)
-        c[d] = static_cast<std::int64_t>(
-          std::floor((p[d] - lower[d]) / link_distance));
-      return c;
-    };
-    auto key_of = [](const std::array<std::int64_t, dim> &c)
-    {
-      std::uint64_t key = 0;
-      for (unsigned int d = 0; d < dim; ++d)
-        key = key * 2097152u + static_cast<std::uint64_t>(c[d] + 1);
-      return key;
-    };
-    std::unordered_map<std::uint64_t, std::vector<unsigned int>> cells;
-    for (unsigned int i = 0; i < n; ++i)
-      cells[key_of(cell_of(points[i]))].push_back(i);
-
-    // Every linked pair once (i < j), and each grain's number of links.
-    std::vector<std::pair<unsigned int, unsigned int>> links;
-    std::vector<unsigned int>                          n_links(n, 0);
-    const double                  link2 = link_distance * link_distance;
-    std::array<std::int64_t, dim> neighbour;
-    for (unsigned int i = 0; i < n; ++i)
-    {
-      const auto c = cell_of(points[i]);
-      for (unsigned int k = 0; k < dealii::Utilities::pow(3u, dim); ++k)
       {
-        unsigned int code = k;
-        for (unsigned int d = 0; d < dim; ++d, code /= 3)
-          neighbour[d] = c[d] + static_cast<std::int64_t>(code % 3) - 1;
-        const auto found = cells.find(key_of(neighbour));
-        if (found != cells.end())
-          for (const unsigned int j : found->second)
-            if (j > i && points[i].distance_square(points[j]) < link2)
-            {
-              links.emplace_back(i, j);
-              ++n_links[i];
-              ++n_links[j];
-            }
+        lower[d] = std::min(lower[d], p[d] - link_distance);
+        upper[d] = std::max(upper[d], p[d] + link_distance);
       }
+    std::vector<Contact::GrainPair<dim>> links;
+    Contact::BucketGrid<dim>(lower, upper)
+      .find_pairs(points, std::vector<double>(n, link_distance / 2), 0, links);
+    std::vector<unsigned int> n_links(n, 0);
+    for (const auto &link : links)
+    {
+      ++n_links[link.first];
+      ++n_links[link.second];
     }
 
     // Core grains (enough neighbours) joined through their links; a thin
@@ -203,11 +172,11 @@ namespace ImmersedGrains
     std::iota(parent.begin(), parent.end(), 0u);
     auto is_core = [&](unsigned int i)
     { return n_links[i] >= core_neighbours; };
-    for (const auto &[i, j] : links)
-      if (is_core(i) && is_core(j))
+    for (const auto &link : links)
+      if (is_core(link.first) && is_core(link.second))
       {
-        const unsigned int a = find_root(parent, i);
-        const unsigned int b = find_root(parent, j);
+        const unsigned int a = find_root(parent, link.first);
+        const unsigned int b = find_root(parent, link.second);
         if (a != b)
           parent[std::min(a, b)] = std::max(a, b);
       }
@@ -215,9 +184,10 @@ namespace ImmersedGrains
     // the order of the links: deterministic); grains with none stay alone.
     std::vector<unsigned int> attached(n,
                                        dealii::numbers::invalid_unsigned_int);
-    for (const auto &[i, j] : links)
+    for (const auto &link : links)
       for (const auto &[border, core] :
-           {std::make_pair(i, j), std::make_pair(j, i)})
+           {std::make_pair(link.first, link.second),
+            std::make_pair(link.second, link.first)})
         if (!is_core(border) && is_core(core) &&
             attached[border] == dealii::numbers::invalid_unsigned_int)
           attached[border] = core;

@@ -337,7 +337,7 @@ namespace ImmersedGrains
                         (centers.size() == 1 || shape == PlacementShape::ball ||
                          shape == PlacementShape::box),
                       "Center",
-                      prm.get("Center"),
+                      center_text,
                       centers.empty() ? "needs a point" :
                                         "several centres (';') need Shape = "
                                         "ball or box");
