@@ -110,6 +110,41 @@ namespace ImmersedGrains
   }
 
 
+  std::vector<std::string>
+  entries_set_in(const std::string &file)
+  {
+    std::ifstream in(file);
+    if (!in)
+      throw InputError(file, "(file)", file, "cannot open the parameter file");
+    std::vector<std::string> path, entries;
+    std::string              line;
+    while (std::getline(in, line))
+    {
+      const auto hash = line.find('#');
+      if (hash != std::string::npos)
+        line.erase(hash);
+      std::istringstream words(line);
+      std::string        first;
+      words >> first;
+      std::string rest;
+      std::getline(words, rest);
+      if (first == "subsection")
+        path.push_back(dealii::Utilities::trim(rest));
+      else if (first == "end" && !path.empty())
+        path.pop_back();
+      else if (first == "set")
+      {
+        const auto  eq = rest.find('=');
+        std::string entry;
+        for (const auto &section : path)
+          entry += section + "/";
+        entries.push_back(entry + dealii::Utilities::trim(rest.substr(0, eq)));
+      }
+    }
+    return entries;
+  }
+
+
   void
   parse_parameter_file(dealii::ParameterHandler &prm, const std::string &file)
   {

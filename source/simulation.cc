@@ -314,6 +314,24 @@ namespace ImmersedGrains
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);
+    // A placement or contact law written for grains that are off would be
+    // ignored without a word, and a scene without fluid or grains would
+    // write empty results: both are mistakes, not choices.
+    InputLocation{file, "Grains"}.require(
+      fluid_parameters.enabled || grain_parameters.enabled,
+      "Enabled",
+      "false",
+      "nothing to simulate: Fluid/Enabled is false as well");
+    if (!grain_parameters.enabled)
+      for (const auto &entry : entries_set_in(file))
+        if ((entry.rfind("Grains/", 0) == 0 && entry != "Grains/Enabled") ||
+            entry.rfind("Contacts/", 0) == 0)
+          InputLocation{file, "Grains"}.fail(
+            "Enabled",
+            "false",
+            "the scene sets " + entry +
+              " but grains are off; set Enabled = true in subsection Grains, "
+              "or remove what is set for them");
     load_balance_parameters.parse_parameters(prm, file);
     checkpoint_parameters.parse_parameters(prm, file);
     cloud_parameters.parse_parameters(prm, file, grain_parameters);
@@ -367,11 +385,17 @@ namespace ImmersedGrains
                   dealii::ExcMessage("Cannot create the output directory '" +
                                      output_directory +
                                      "': " + error.message()));
-      std::filesystem::copy_file(
-        parameter_file,
+      // A copy of the scene beside its results, unless the scene is
+      // already there (a parameter file kept in its output directory).
+      const std::filesystem::path copy =
         output_directory + "/" +
-          std::filesystem::path(parameter_file).filename().string(),
-        std::filesystem::copy_options::overwrite_existing);
+        std::filesystem::path(parameter_file).filename().string();
+      if (!std::filesystem::exists(copy) ||
+          !std::filesystem::equivalent(parameter_file, copy))
+        std::filesystem::copy_file(
+          parameter_file,
+          copy,
+          std::filesystem::copy_options::overwrite_existing);
     }
     MPI_Barrier(comm);
     log.open(
@@ -464,13 +488,16 @@ namespace ImmersedGrains
 
     if (fluid && grains)
     {
-      coupling = std::make_unique<Coupling<dim>>(coupling_parameters,
-                                                 grain_parameters,
-                                                 geometry,
-                                                 triangulation,
-                                                 fluid_parameters.density,
-                                                 fluid_parameters.viscosity,
-                                                 *timer);
+      coupling =
+        std::make_unique<Coupling<dim>>(coupling_parameters,
+                                        grain_parameters,
+                                        geometry,
+                                        triangulation,
+                                        fluid_parameters.density,
+                                        fluid_parameters.viscosity,
+                                        fluid_parameters.time_derivative,
+                                        fluid_parameters.advection,
+                                        *timer);
       coupling->setup();
       coupling->attach(*fluid);
       coupling->project(*grains);

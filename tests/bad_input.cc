@@ -255,6 +255,17 @@ end
              "  set Solid fraction = 0.4\n end\nend\n",
          "Center",
          "0.4, 0.5; 0.5, 0.5"},
+        // A placement for grains left off: an error, not a fluid-only run.
+        {"grains_section_while_disabled",
+         "set Dimension = 2\nsubsection Grains\n set Radius = 0.01\n"
+             " subsection Placement\n  set Shape = ball\n  set Center = 0.5, "
+             "0.5\n  set Size = 0.2\n end\nend\n",
+         "Enabled",
+         "Grains/Radius"},
+        {"nothing_to_simulate",
+         "set Dimension = 2\nsubsection Fluid\n set Enabled = false\nend\n",
+         "Enabled",
+         "nothing to simulate"},
   };
 
   unsigned int failures = 0;

@@ -57,6 +57,11 @@ namespace ImmersedGrains
    * Parses the whole file into @p prm; any deal.II parse error (unknown
    * entry, malformed value, value out of range) becomes an InputError.
    */
+  /** The entries @p file sets, as "Section/Subsection/Name" (the file's
+   *  spelling; ParameterHandler checked them). */
+  std::vector<std::string>
+  entries_set_in(const std::string &file);
+
   void
   parse_parameter_file(dealii::ParameterHandler &prm, const std::string &file);
 

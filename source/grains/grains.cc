@@ -36,7 +36,11 @@ namespace ImmersedGrains
         l.angular_velocity =
           add("angular_velocity", dim == 2 ? 1 : 3, dim == 3);
       if (with_fluid)
-        l.fluid_force = add("fluid_force", dim, true);
+      {
+        l.fluid_force   = add("fluid_force", dim, true);
+        l.drag_force    = add("drag_force", dim, true);
+        l.self_velocity = add("self_velocity", dim, true);
+      }
       if (with_fluid && prm.contacts_enabled)
         l.contact_impulse = add("contact_impulse", dim, true);
       if (prm.has_fixed_region)
@@ -387,6 +391,9 @@ namespace ImmersedGrains
     const bool impulses =
       properties.contact_impulse != GrainPropertyLayout::absent;
     arrays.contact_impulse.resize(impulses ? n : 0);
+    const bool drags = properties.drag_force != GrainPropertyLayout::absent;
+    arrays.drag_force.resize(drags ? n : 0);
+    arrays.self_velocity.resize(drags ? n : 0);
 
     unsigned int i = 0;
     for (const auto &p : particles)
@@ -405,6 +412,12 @@ namespace ImmersedGrains
       if (impulses)
         for (unsigned int d = 0; d < dim; ++d)
           arrays.contact_impulse[i][d] = props[properties.contact_impulse + d];
+      if (drags)
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          arrays.drag_force[i][d]    = props[properties.drag_force + d];
+          arrays.self_velocity[i][d] = props[properties.self_velocity + d];
+        }
       ++i;
     }
     c.start_velocity = c.velocity;
@@ -617,6 +630,14 @@ namespace ImmersedGrains
             (arrays.drag_velocity[i] - c.velocity[i]);
         for (unsigned int d = 0; d < dim; ++d)
           props[properties.fluid_force + d] = force[d];
+        const dealii::Tensor<1, dim> drag =
+          arrays.drag_coefficient[i] *
+          (arrays.drag_velocity[i] - c.velocity[i]);
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          props[properties.drag_force + d]    = drag[d];
+          props[properties.self_velocity + d] = arrays.self_velocity[i][d];
+        }
       }
       if (friction)
         for (unsigned int d = 0; d < (dim == 2 ? 1 : 3); ++d)

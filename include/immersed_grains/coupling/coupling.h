@@ -7,6 +7,7 @@
 
 #include <immersed_grains/coupling/drag_law.h>
 #include <immersed_grains/coupling/filtered_drag.h>
+#include <immersed_grains/coupling/self_disturbance.h>
 #include <immersed_grains/coupling/solid_fraction.h>
 #include <immersed_grains/fluid/mixture_fields.h>
 
@@ -21,6 +22,8 @@ namespace ImmersedGrains
   class Grains;
   template <int dim>
   struct GrainParameters;
+  template <int dim>
+  struct GrainStepArrays;
 
   /**
    * The two-way exchange between the averaged fluid and the grains (the
@@ -69,6 +72,7 @@ namespace ImmersedGrains
       bool                                    implicit_coupling = true;
       bool                                    grain_substeps    = true;
       double                                  resting_threshold = 1e-3;
+      bool                                    self_correction   = false;
       typename SolidFraction<dim>::Parameters projection;
     };
 
@@ -78,6 +82,8 @@ namespace ImmersedGrains
              const dealii::parallel::distributed::Triangulation<dim> &tria,
              double               fluid_density,
              double               fluid_viscosity,
+             bool                 fluid_transient,
+             bool                 fluid_advection,
              dealii::TimerOutput &timer);
 
     /** After every mesh change. */
@@ -161,11 +167,16 @@ namespace ImmersedGrains
     const dealii::parallel::distributed::Triangulation<dim> &triangulation;
     const double                                             density;
     const double                                             viscosity;
-    dealii::TimerOutput                                     &timer;
+    // Whether the fluid has a time derivative and advection: how a grain's
+    // own disturbance builds up (SelfDisturbance).
+    const bool           fluid_transient;
+    const bool           fluid_advection;
+    dealii::TimerOutput &timer;
 
     std::shared_ptr<SolidFraction<dim>> projection;
     std::unique_ptr<FilteredDrag<dim>>  filtered_drag; // only if chosen
     std::unique_ptr<DragLaw>            drag_law;
+    SelfDisturbance<dim>                self_disturbance;
 
     bool
     drag_as_field() const
@@ -187,6 +198,33 @@ namespace ImmersedGrains
                double                        fluid_fraction,
                const dealii::Tensor<1, dim> &slip) const;
 
+    /// The fluid fraction a free grain's drag law reads, without its own
+    /// share of the solid fraction, and its own disturbance of the velocity
+    /// it feels after a step @p dt: @p last_self relaxed towards the
+    /// self-mobility times the force its @p last_drag put on the fluid
+    /// (SelfDisturbance), or kept with @p dt = 0 (a later sub-step: the
+    /// fluid is frozen); unchanged and zero without the correction, for
+    /// fixed grains and for grains held by contacts.
+    std::pair<double, dealii::Tensor<1, dim>>
+    undisturbed(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const dealii::Point<dim>     &reference,
+      double                        radius,
+      double                        felt_fraction,
+      const dealii::Tensor<1, dim> &slip,
+      const GrainStepArrays<dim>   &arrays,
+      unsigned int                  i,
+      double                        dt,
+      bool                          free) const;
+
+    /// Whether grain @p i is held by its contacts: it kept at most
+    /// Resting threshold of the velocity its last contact impulse removed
+    /// from its @p drag_mass (m + dt gamma).
+    bool
+    held(const GrainStepArrays<dim> &arrays,
+         unsigned int                i,
+         double                      drag_mass) const;
+
     /// The grains' hooks: @p as_predicted for the first (or only) grain
     /// step, with gamma and the force the fluid's prediction used.
     void
@@ -199,6 +237,8 @@ namespace ImmersedGrains
 
     std::vector<dealii::Tensor<1, dim>> lagged_force; // without m g
     std::vector<double>                 gamma;
+    // The grain's own disturbance of the velocity it feels (undisturbed()).
+    std::vector<dealii::Tensor<1, dim>> self_velocity;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 

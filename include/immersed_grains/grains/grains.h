@@ -37,6 +37,8 @@ namespace ImmersedGrains
     unsigned int radius           = absent;
     unsigned int angular_velocity = absent;
     unsigned int fluid_force      = absent;
+    unsigned int drag_force       = absent;
+    unsigned int self_velocity    = absent;
     unsigned int contact_impulse  = absent;
     unsigned int fixed            = absent;
     unsigned int n_properties     = 0;
@@ -80,6 +82,15 @@ namespace ImmersedGrains
      *  The coupling predicts the drag the fluid receives with it, so that a
      *  grain held by contacts does not push the fluid. */
     std::vector<dealii::Tensor<1, dim>> contact_impulse;
+
+    /** With a fluid: the drag each grain felt over its last step [N], of
+     *  the last step on gather(); the coupling estimates the grain's own
+     *  disturbance of the fluid from it. */
+    std::vector<dealii::Tensor<1, dim>> drag_force;
+    /** With a fluid: the grain's own disturbance of the velocity it feels
+     *  (Coupling/Self-disturbance correction), of the last step on
+     *  gather(); the coupling sets this step's. */
+    std::vector<dealii::Tensor<1, dim>> self_velocity;
   };
 
   /** Global measures of the grain population (sums/means over ranks). */
