@@ -802,36 +802,67 @@ namespace ImmersedGrains
     // would print its own complaint beside the one-line message.
     timer = std::make_unique<dealii::TimerOutput>(
       comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times);
-    prepare_output_directory(resumed_step);
-    setup(resume_from);
-    start_time         = time;
-    last_progress_wall = now();
-    if (resume_from.empty())
-    {
-      postprocess(0, 0);
-      maybe_write_fields(true);
-    }
-    record_timings();
-
-    // Steps end exactly on End time; a last short step is allowed.
+    const bool serial  = dealii::Utilities::MPI::n_mpi_processes(comm) == 1;
+    bool       in_step = false;
     try
     {
+      prepare_output_directory(resumed_step);
+      setup(resume_from);
+      start_time         = time;
+      last_progress_wall = now();
+      if (resume_from.empty())
+      {
+        postprocess(0, 0);
+        maybe_write_fields(true);
+      }
+      record_timings();
+
+      // Steps end exactly on End time; a last short step is allowed.
       while (time < end_time * (1 - 1e-12))
       {
         maybe_adapt_mesh();
         const double dt = next_time_step();
         ++step;
+        in_step = true;
         solve_time_step(dt);
+        stop_if_not_finite();
+        in_step = false;
         maybe_write_fields(time >= end_time * (1 - 1e-12));
         record_timings();
         maybe_write_checkpoint();
       }
     }
-    catch (...)
+    catch (const std::exception &e)
     {
-      // A run that fails (a solver that does not converge) ends with main's
-      // one-line message; destroyed here, where no exception is in flight,
-      // the timer does not add its own complaint.
+      // A run that fails ends with main's one-line message; destroyed
+      // here, where no exception is in flight, the timer does not add its
+      // own complaint. A step that fails (a solver that does not converge,
+      // grains lost) leaves what it reached as a last output to look at,
+      // and says which step it was: on one rank, where the failure is
+      // known to have reached every process.
+      std::string message;
+      if (const auto *d = dynamic_cast<const dealii::ExceptionBase *>(&e))
+      {
+        std::ostringstream info;
+        d->print_info(info);
+        message = one_line(info.str());
+      }
+      if (in_step && serial && !message.empty())
+      {
+        try
+        {
+          maybe_write_fields(true);
+          message += " The last output (step " + std::to_string(step) +
+                     ") holds the failed step.";
+        }
+        catch (...)
+        {
+        }
+        std::ostringstream where;
+        where << "step " << step << " (t = " << time << " s): ";
+        timer.reset();
+        throw std::runtime_error(where.str() + message);
+      }
       timer.reset();
       throw;
     }
@@ -1222,6 +1253,98 @@ namespace ImmersedGrains
     const bool regular = step % test_every == 0;
     if (last ? !regular : regular)
       statistics.print(std::cout, test_columns);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::stop_if_not_finite()
+  {
+    // One norm each, on every step: the search below runs only on failure.
+    const bool fluid_finite =
+      !fluid || std::isfinite(fluid->get_solution().l2_norm());
+    const bool grains_finite =
+      !grains || (std::isfinite(statistics.get("kinetic_energy")) &&
+                  (statistics.get("particles") == 0 ||
+                   std::isfinite(statistics.get("centroid_x"))));
+    if (fluid_finite && grains_finite)
+      return;
+
+    std::string        field;
+    dealii::Point<dim> where;
+    bool               found = false;
+    if (!fluid_finite)
+    {
+      const auto &dof_handler = fluid->get_dof_handler();
+      const auto &solution    = fluid->get_solution();
+      const auto &fe          = dof_handler.get_fe();
+      std::vector<dealii::types::global_dof_index> indices(
+        fe.n_dofs_per_cell());
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (!found && cell->is_locally_owned())
+        {
+          cell->get_dof_indices(indices);
+          for (unsigned int i = 0; i < indices.size() && !found; ++i)
+            if (!std::isfinite(solution[indices[i]]))
+            {
+              found = true;
+              where = cell->center();
+              field = fe.system_to_component_index(i).first < dim ?
+                        "fluid velocity" :
+                        "fluid pressure";
+            }
+        }
+    }
+    if (!found && grains)
+    {
+      const unsigned int velocity = grains->layout().velocity;
+      for (const auto &p : grains->particle_handler())
+      {
+        const auto props           = p.get_properties();
+        bool       finite_velocity = true, finite_position = true;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          finite_velocity &= std::isfinite(props[velocity + d]);
+          finite_position &= std::isfinite(p.get_location()[d]);
+        }
+        if (!finite_velocity || !finite_position)
+        {
+          found = true;
+          where = finite_position ? p.get_location() :
+                                    p.get_surrounding_cell()->center();
+          field = "velocity of grain " + std::to_string(p.get_id());
+          break;
+        }
+      }
+    }
+    // The lowest rank that found one tells.
+    const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+    const unsigned int rank    = dealii::Utilities::MPI::this_mpi_process(comm);
+    const unsigned int teller =
+      dealii::Utilities::MPI::min(found ? rank : n_ranks, comm);
+    std::ostringstream text;
+    if (teller == n_ranks)
+      text << "a global sum of the fluid or of the grains";
+    else
+    {
+      text << "the " << field << " near (";
+      for (unsigned int d = 0; d < dim; ++d)
+        text << (d > 0 ? ", " : "") << where[d];
+      text << ")";
+    }
+    const std::string place =
+      dealii::Utilities::MPI::broadcast(comm,
+                                        text.str(),
+                                        teller == n_ranks ? 0 : teller);
+    maybe_write_fields(true);
+    std::ostringstream message;
+    message << "step " << step << " (t = " << time << " s): " << place
+            << " is not finite (NaN or Inf); the run diverged there. The last "
+               "output (step "
+            << step
+            << ") holds it; a shorter Time step, or Adaptive time step = "
+               "true, usually keeps it finite.";
+    throw std::runtime_error(message.str());
   }
 
 

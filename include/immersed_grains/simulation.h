@@ -108,6 +108,11 @@ namespace ImmersedGrains
     set_cloud_statistics();
     void
     maybe_write_fields(bool force);
+    /** Stops the run (collective) where the fluid's solution or a grain's
+     *  velocity or position is NaN or Inf: the step, the field and where,
+     *  after a last output. */
+    void
+    stop_if_not_finite();
     /** The progress line, at most every Progress every seconds (a quarter
      *  of a second on a terminal); @p last: the run's last one. */
     void

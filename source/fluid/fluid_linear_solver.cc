@@ -10,6 +10,8 @@
 #include <immersed_grains/fluid/block_preconditioner.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
+#include <cmath>
+
 #include <cstdlib>
 #include <sstream>
 
@@ -295,6 +297,13 @@ namespace ImmersedGrains
     }
     catch (const dealii::SolverControl::NoConvergence &e)
     {
+      AssertThrow(std::isfinite(e.last_residual),
+                  dealii::ExcMessage(
+                    "Fluid: the linear system is not finite (FGMRES residual "
+                    "NaN or Inf in iteration " +
+                    std::to_string(e.last_step) +
+                    "): the state it was assembled from diverged, or a "
+                    "forcing or boundary value is not finite."));
       if (fresh_preconditioner)
         AssertThrow(false,
                     dealii::ExcMessage(
