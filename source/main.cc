@@ -17,6 +17,9 @@ namespace
   const char *usage =
     "usage: immersed-grains SCENE.prm          run a scene (mpirun -np N "
     "works)\n"
+    "       immersed-grains --check SCENE.prm  validate it (placement, mesh,\n"
+    "                                          memory) without writing, and\n"
+    "                                          print its regime and warnings\n"
     "       immersed-grains --print-parameters [2|3]\n"
     "                                          every parameter, its default\n"
     "                                          and documentation\n"
@@ -31,6 +34,17 @@ namespace
     ImmersedGrains::parse_parameter_file(prm, file);
     ImmersedGrains::Simulation<dim> simulation(prm, file, MPI_COMM_WORLD);
     simulation.run();
+  }
+
+  template <int dim>
+  void
+  check_scene(const std::string &file)
+  {
+    dealii::ParameterHandler prm;
+    ImmersedGrains::Simulation<dim>::declare_parameters(prm);
+    ImmersedGrains::parse_parameter_file(prm, file);
+    const ImmersedGrains::Simulation<dim> simulation(prm, file, MPI_COMM_WORLD);
+    simulation.print_check(std::cout);
   }
 
   template <int dim>
@@ -73,6 +87,18 @@ main(int argc, char **argv)
                                  dim + "'");
       if (root)
         (dim == "2" ? print_parameters<2>() : print_parameters<3>());
+      return 0;
+    }
+    if (args[0] == "--check")
+    {
+      if (args.size() != 2)
+        throw std::runtime_error("--check takes one scene file");
+      const std::string  file = args[1];
+      const unsigned int dim  = ImmersedGrains::read_dimension(file);
+      if (dim == 2)
+        check_scene<2>(file);
+      else
+        check_scene<3>(file);
       return 0;
     }
     if (args.size() != 1 || args[0].rfind("-", 0) == 0)

@@ -344,7 +344,11 @@ namespace ImmersedGrains
     if (grain_parameters.enabled)
       grain_seeds = place_grains(grain_parameters, geometry);
     for (const auto &seed : grain_seeds)
+    {
       largest_grain_radius = std::max(largest_grain_radius, seed.radius);
+      mean_grain_radius += seed.radius / grain_seeds.size();
+    }
+    placed_grains = grain_seeds.size();
 
     // Stop here, before anything large is allocated or written, if the
     // scene cannot fit: the kernel would kill it half-way instead.
@@ -501,6 +505,11 @@ namespace ImmersedGrains
       coupling->setup();
       coupling->attach(*fluid);
       coupling->project(*grains);
+      // Once per run, in the log and on the screen: a choice outside what
+      // the model is validated for (immersed-grains --check lists them).
+      if (!resumed)
+        for (const auto &warning : regime().warnings)
+          pcout << "  warning: " << warning << '\n';
       pcout << "  coupling: drag law " << coupling_parameters.drag_law
             << (coupling_parameters.tracers ?
                   ", tracers" :
@@ -1260,9 +1269,21 @@ namespace ImmersedGrains
   void
   Simulation<dim>::stop_if_not_finite()
   {
-    // One norm each, on every step: the search below runs only on failure.
-    const bool fluid_finite =
-      !fluid || std::isfinite(fluid->get_solution().l2_norm());
+    // One pass over the owned values (a ghosted vector has no norm) and
+    // two statistics, on every step: the search below runs only on failure.
+    bool fluid_finite = true;
+    if (fluid)
+    {
+      const auto &solution = fluid->get_solution();
+      for (const auto i : solution.locally_owned_elements())
+        if (!std::isfinite(solution[i]))
+        {
+          fluid_finite = false;
+          break;
+        }
+      fluid_finite =
+        dealii::Utilities::MPI::min(fluid_finite ? 1 : 0, comm) == 1;
+    }
     const bool grains_finite =
       !grains || (std::isfinite(statistics.get("kinetic_energy")) &&
                   (statistics.get("particles") == 0 ||

@@ -262,6 +262,14 @@ end
              "0.5\n  set Size = 0.2\n end\nend\n",
          "Enabled",
          "Grains/Radius"},
+        // Refused before a billion radii are drawn.
+        {"count_beyond_memory",
+         "set Dimension = 3\nsubsection Grains\n set Enabled = true\n set "
+             "Radius = 1e-3\n subsection Placement\n  set Shape = box\n  set "
+             "Center = 0.5, 0.5, 0.5\n  set Size = 1\n  set Count = "
+             "1000000000\n end\nend\n",
+         "Count",
+         "1000000000"},
         {"nothing_to_simulate",
          "set Dimension = 2\nsubsection Fluid\n set Enabled = false\nend\n",
          "Enabled",

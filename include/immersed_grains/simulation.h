@@ -20,6 +20,7 @@
 #include <immersed_grains/mesh/geometry.h>
 #include <immersed_grains/mesh/load_balance.h>
 #include <immersed_grains/mesh/size_estimate.h>
+#include <immersed_grains/scene_regime.h>
 
 #include <functional>
 #include <map>
@@ -58,6 +59,18 @@ namespace ImmersedGrains
 
     void
     run();
+
+    /** The scene's regime: grain and cloud Reynolds numbers, Stokes
+     *  number, dt over the grains' relaxation time, cell over grain and
+     *  over filter sizes, what is on and off, and warnings
+     *  (source/scene_regime.cc). */
+    SceneRegime
+    regime() const;
+
+    /** --check: the scene parsed, placed and estimated without writing
+     *  anything; prints its size and regime on @p out (rank 0). */
+    void
+    print_check(std::ostream &out) const;
 
   private:
     // With @p resumed_step >= 0 the files of the run being resumed are
@@ -157,6 +170,8 @@ namespace ImmersedGrains
     Checkpoint::Parameters                  checkpoint_parameters;
     typename CloudAnalysis<dim>::Parameters cloud_parameters;
     double                                  largest_grain_radius = 0;
+    double                                  mean_grain_radius    = 0;
+    unsigned int                            placed_grains        = 0;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
     SizeEstimate                size_estimate;

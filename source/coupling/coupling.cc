@@ -87,12 +87,13 @@ namespace ImmersedGrains
         "its own disturbance of the velocity it feels (the force it put on "
         "the fluid times the self-mobility of the drag distribution, built "
         "up over the distribution's diffusion time, doc/theory.md) out of "
-        "its slip. Validated for lone grains in 3D with the cell and "
-        "filtered distributions (cells of 2 to 8 diameters: the settling "
-        "velocity no longer depends on the cell); in suspensions it "
-        "over-corrects (doc/validation.md), hence off by default. The "
-        "velocity part is not modelled in 2D (a disc's disturbance grows "
-        "with the box) nor for the point distribution.");
+        "its slip. Validated in 3D for lone grains with the cell and "
+        "filtered distributions (the settling velocity no longer depends on "
+        "the cell) and for suspensions with the filtered one; with the cell "
+        "spread it over-corrects suspensions by about 12 %, and the velocity "
+        "part is not modelled in 2D (a disc's disturbance grows "
+        "with the box) nor for the point distribution: hence off by "
+        "default (doc/validation.md).");
       SolidFraction<dim>::Parameters::declare_parameters(prm);
     }
     prm.leave_subsection();

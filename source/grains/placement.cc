@@ -87,6 +87,13 @@ namespace ImmersedGrains
       std::vector<double> radii;
       if (prm.count > 0)
       {
+        // Checked before anything is drawn: the size estimate comes after
+        // the placement.
+        InputLocation{prm.file, "Grains/Placement"}.require(
+          prm.count <= 50'000'000,
+          "Count",
+          prm.count_text,
+          "more than 5e7 grains");
         for (unsigned int k = 0; k < prm.count; ++k)
           radii.push_back(draw_radius(prm, random));
         return radii;

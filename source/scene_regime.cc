@@ -1,0 +1,239 @@
+// Simulation<dim>::regime() and print_check(): what a scene is, in the
+// numbers that decide which physics it needs, and where its choices leave
+// the range the model is validated for (doc/validation.md).
+#include <immersed_grains/coupling/drag_law.h>
+#include <immersed_grains/simulation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    std::string
+    number(const double x, const int digits = 3)
+    {
+      std::ostringstream s;
+      s << std::setprecision(digits) << x;
+      return s.str();
+    }
+  } // namespace
+
+
+  template <int dim>
+  SceneRegime
+  Simulation<dim>::regime() const
+  {
+    SceneRegime regime;
+    auto        line = [&](const std::string &name,
+                    const std::string &value,
+                    const std::string &meaning)
+    {
+      regime.lines.push_back(name + ": " + value +
+                             (meaning.empty() ? "" : " (" + meaning + ")"));
+    };
+
+    // The finest cell the scene will have.
+    const unsigned int levels = adaptivity_parameters.enabled ?
+                                  adaptivity_parameters.max_level :
+                                  geometry.initial_refinement;
+    double             h      = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+      h = std::min(h,
+                   (geometry.upper_corner[d] - geometry.lower_corner[d]) /
+                     geometry.subdivisions[d] / std::pow(2.0, levels));
+    line("finest cell", number(h) + " m", "");
+
+    const bool   with_fluid  = fluid_parameters.enabled;
+    const bool   with_grains = grain_parameters.enabled;
+    const double r =
+      mean_grain_radius > 0 ? mean_grain_radius : grain_parameters.radius;
+    const double rho     = fluid_parameters.density;
+    const double mu      = fluid_parameters.viscosity;
+    const double g       = grain_parameters.gravity.norm();
+    const double d       = 2 * r;
+    const double l       = coupling_parameters.projection.smoothing_length;
+    const bool   coupled = with_fluid && with_grains;
+    const bool   two_way = coupled && coupling_parameters.two_way;
+
+    double reynolds = 0, cloud_reynolds = 0;
+    if (with_grains)
+    {
+      line("grains",
+           std::to_string(placed_grains) + ", mean radius " + number(r) + " m",
+           "");
+      line("cell / grain diameter", number(h / d), "");
+    }
+    if (coupled && g > 0)
+    {
+      // The lone grain's terminal velocity under the scene's drag law.
+      const auto   law    = DragLaw::create(coupling_parameters.drag_law);
+      const double volume = dim == 2 ? M_PI * r * r : 4. / 3 * M_PI * r * r * r;
+      const double area   = dim == 2 ? 2 * r : M_PI * r * r;
+      const double mass   = grain_parameters.density * volume;
+      const double weight =
+        std::abs(grain_parameters.density - rho) * volume * g;
+      double U = 0, gamma = 0;
+      for (unsigned int k = 0; k < 200; ++k)
+      {
+        gamma = law->coefficient({r, area, volume, 1.0, U, rho, mu});
+        const double next = weight / gamma;
+        if (std::abs(next - U) <= 1e-12 * next)
+          break;
+        U = 0.5 * (U + next);
+      }
+      const double tau = mass / gamma;
+      reynolds         = 2 * r * rho * U / mu;
+      line("lone grain's terminal velocity",
+           number(U) + " m/s",
+           "its drag law");
+      line("grain Reynolds number", number(reynolds), "2 r rho U / mu");
+      line("grain relaxation time", number(tau) + " s", "tau_p = m / gamma");
+      line("Stokes number", number(tau * U / d), "tau_p U / d");
+      line("time step / tau_p",
+           number(time_step / tau),
+           adaptive_time_step ? "the first step; later ones follow the flow" :
+                                "");
+      if (coupling_parameters.drag_distribution == "filtered" && l > 0)
+        line("cell / filter length", number(h / l), "");
+      if (grain_parameters.shape == PlacementShape::ball &&
+          !grain_parameters.size.empty())
+      {
+        const double R = grain_parameters.size[0];
+        if (dim == 3)
+        {
+          // The Hadamard-Rybczynski drop of the cloud's excess density,
+          // its interior as viscous as the liquid.
+          const double excess = grain_parameters.solid_fraction *
+                                std::abs(grain_parameters.density - rho);
+          const double cloud_velocity = 4. / 15 * excess * g * R * R / mu;
+          cloud_reynolds              = rho * cloud_velocity * R / mu;
+          line("cloud Reynolds number",
+               number(cloud_reynolds),
+               "rho U R / mu with the Hadamard-Rybczynski U = " +
+                 number(cloud_velocity) + " m/s");
+        }
+        else
+          line("cloud Reynolds number",
+               "not estimated in 2D",
+               "a 2D cloud's velocity depends on the box; statistics.csv "
+               "has cloud_velocity_y");
+      }
+    }
+
+    // What is on and off.
+    auto on = [](const bool b) { return std::string(b ? "on" : "off"); };
+    if (with_fluid)
+    {
+      std::string why;
+      // A 2D cloud's Reynolds number is not estimated: no advice there.
+      const bool cloud_unknown =
+        dim == 2 && grain_parameters.shape == PlacementShape::ball;
+      if (fluid_parameters.advection && coupled && !cloud_unknown &&
+          std::max(reynolds, cloud_reynolds) < 1e-3)
+        why = "; the flow is Stokes here (Reynolds numbers below 1e-3): "
+              "Advection = false gives the same answer for less";
+      regime.switches.push_back(
+        "fluid: " +
+        std::string(fluid_parameters.advection ? "Navier-Stokes" : "Stokes") +
+        (fluid_parameters.time_derivative ? ", unsteady" : ", steady") + why);
+    }
+    else
+      regime.switches.push_back("fluid: off (grains in vacuum)");
+    if (with_grains)
+      regime.switches.push_back(
+        "contacts: " + on(grain_parameters.contacts_enabled) +
+        (grain_parameters.contacts_enabled ?
+           ", friction " + number(grain_parameters.contact.friction) :
+           std::string()));
+    if (coupled)
+      regime.switches.push_back(
+        "coupling: " +
+        std::string(coupling_parameters.tracers ?
+                      "tracers" :
+                      (two_way ? "two-way" : "one-way")) +
+        ", drag law " + coupling_parameters.drag_law + ", drag distribution " +
+        coupling_parameters.drag_distribution +
+        ", self-disturbance correction " +
+        on(coupling_parameters.self_correction) + ", grain sub-steps " +
+        on(coupling_parameters.grain_substeps));
+    regime.switches.push_back(
+      "adaptivity: " + on(adaptivity_parameters.enabled) +
+      "; adaptive time step: " + on(adaptive_time_step));
+
+    // Outside the validated range (doc/validation.md).
+    const bool spread_in_cells =
+      coupling_parameters.drag_distribution != "filtered";
+    if (two_way && dim == 3 && spread_in_cells &&
+        !coupling_parameters.self_correction && h < 8 * d)
+      regime.warnings.push_back(
+        "cells of " + number(h / d, 2) +
+        " grain diameters with Drag distribution = " +
+        coupling_parameters.drag_distribution +
+        ": each grain feels its own disturbance of the velocity (a lone "
+        "grain settles 10-17 % too fast at 2-8 diameters, a suspension 11 % "
+        "at 4 and 31 % at 2, doc/validation.md); use Drag distribution = "
+        "filtered with Smoothing length of at least 8 grain radii, or "
+        "coarser cells");
+    if (two_way && dim == 2 && spread_in_cells &&
+        grain_parameters.shape != PlacementShape::ball)
+      regime.warnings.push_back(
+        "2D with Drag distribution = " + coupling_parameters.drag_distribution +
+        ": a disc's own disturbance decays only logarithmically, and a lone "
+        "disc settles 2.4-4 times too fast whatever the cell "
+        "(doc/validation.md); use Drag distribution = filtered with "
+        "Smoothing length about half the box (2D suspensions then lie "
+        "within 0.5 % of the closure)");
+    if (two_way && !spread_in_cells && dim == 3 && l < 4 * d)
+      regime.warnings.push_back(
+        "Smoothing length " + number(l) + " m is " + number(l / r, 2) +
+        " grain radii: below 8 radii a grain feels its own disturbance "
+        "(4 % too fast at 8 radii and phi_s = 0.3, more below, "
+        "doc/validation.md); use at least 8 radii");
+    if (coupled && h < d && l < d)
+      regime.warnings.push_back(
+        "cells of " + number(h / d, 2) +
+        " grain diameters without a Smoothing length of a diameter or more: "
+        "the projected solid fraction peaks far above the packing it "
+        "stands for (doc/validation.md); set Coupling/Smoothing length to a "
+        "grain diameter or two");
+    return regime;
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::print_check(std::ostream &out) const
+  {
+    if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    const SceneRegime scene = regime();
+    out << parameter_file << ": checked, nothing written.\n"
+        << "  size: " << number(size_estimate.cells) << " cells, "
+        << number(size_estimate.dofs) << " fluid DoFs, peak memory about "
+        << number(size_estimate.peak_bytes / (1 << 30)) << " GiB\n"
+        << "  regime:\n";
+    for (const auto &l : scene.lines)
+      out << "    " << l << '\n';
+    out << "  switched:\n";
+    for (const auto &s : scene.switches)
+      out << "    " << s << '\n';
+    if (scene.warnings.empty())
+      out << "  no choice outside the validated range\n";
+    for (const auto &w : scene.warnings)
+      out << "  warning: " << w << '\n';
+  }
+
+
+  template SceneRegime
+  Simulation<2>::regime() const;
+  template SceneRegime
+  Simulation<3>::regime() const;
+  template void
+  Simulation<2>::print_check(std::ostream &) const;
+  template void
+  Simulation<3>::print_check(std::ostream &) const;
+} // namespace ImmersedGrains

@@ -1,0 +1,73 @@
+// immersed-grains --check SCENE.prm: the scene is parsed, its grains placed
+// and its size estimated, nothing is written, and the regime is printed with
+// the choices that lie outside the validated range. The scene: 200 seed
+// beads in glycerine in a 3D box with cells of 2 grain diameters and the
+// cell-spread drag (a warning: grains feel their own disturbance there),
+// and the same with a Stokes fluid and the filtered drag (none).
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+void
+check(const std::string &name, const std::string &coupling)
+{
+  fs::remove_all("out_" + name);
+  {
+    std::ofstream f(name + ".prm");
+    f << "set Dimension = 3\n"
+         "set Output directory = out_"
+      << name
+      << "\n"
+         "set Time step = 1e-3\n"
+         "subsection Mesh\n"
+         "  set Upper corner = 8e-4, 8e-4, 8e-4\n"
+         "  set Subdivisions = 16\n"
+         "  set Initial refinement = 0\n"
+         "end\n"
+         "subsection Fluid\n"
+         "  set Density = 1200\n"
+         "  set Viscosity = 0.12\n"
+      << (coupling.empty() ? "" : "  set Advection = false\n")
+      << "end\n"
+         "subsection Coupling\n"
+      << coupling
+      << "end\n"
+         "subsection Grains\n"
+         "  set Enabled = true\n"
+         "  set Radius = 12.5e-6\n"
+         "  set Density = 2400\n"
+         "  subsection Placement\n"
+         "    set Shape = box\n"
+         "    set Center = 4e-4, 4e-4, 4e-4\n"
+         "    set Size = 6e-4\n"
+         "    set Count = 200\n"
+         "  end\n"
+         "end\n"
+         "subsection Gravity\n"
+         "  set Vector = 0, 0, -9.81\n"
+         "end\n";
+  }
+  const std::string command = std::string(IMMERSED_GRAINS_EXECUTABLE) +
+                              " --check " + name + ".prm > stdout_" + name +
+                              " 2>&1";
+  const int status = std::system(command.c_str());
+  std::cout << name << ": exit status " << (status == 0 ? "0" : "non-zero")
+            << ", output directory "
+            << (fs::exists("out_" + name) ? "written" : "absent") << '\n';
+  std::ifstream out("stdout_" + name);
+  for (std::string line; std::getline(out, line);)
+    std::cout << line << '\n';
+}
+
+int
+main()
+{
+  check("cell_spread", "");
+  check("filtered",
+        "  set Drag distribution = filtered\n"
+        "  set Smoothing length = 1e-4\n");
+}
