@@ -88,7 +88,11 @@ def limit_memory():
 
 
 def classify(status, stderr, timed_out):
-    lines = [l for l in stderr.splitlines() if l.strip()]
+    # Lines end at '\n' only (str.splitlines would also split at control
+    # characters, which a message must not carry either).
+    lines = [l for l in stderr.split("\n") if l.strip()]
+    if any(ord(c) < 32 and c not in "\t" for l in lines for c in l):
+        return "control characters on stderr"
     if timed_out:
         return "timeout"
     if status < 0:

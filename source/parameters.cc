@@ -3,6 +3,8 @@
 
 #include <immersed_grains/parameters.h>
 
+#include <cctype>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -20,6 +22,18 @@ namespace ImmersedGrains
         if (!in_space)
           result += ' ';
         in_space = true;
+      }
+      else if (std::iscntrl(static_cast<unsigned char>(c)))
+      {
+        // A control character quoted from a damaged file would act on the
+        // terminal: shown as its code instead.
+        char code[8];
+        std::snprintf(code,
+                      sizeof(code),
+                      "\\x%02x",
+                      static_cast<unsigned int>(static_cast<unsigned char>(c)));
+        result += code;
+        in_space = false;
       }
       else
       {

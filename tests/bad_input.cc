@@ -270,6 +270,12 @@ end
              "1000000000\n end\nend\n",
          "Count",
          "1000000000"},
+        // Found by scripts/fuzz_input.py: a damaged line quoted in the
+        // message carried its control characters to the terminal.
+        {"control_characters",
+         "set Dimension = 2\n\x1e front\x1d garbled\n",
+         "\\x1e",
+         "\\x1d"},
         {"nothing_to_simulate",
          "set Dimension = 2\nsubsection Fluid\n set Enabled = false\nend\n",
          "Enabled",
