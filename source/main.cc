@@ -25,26 +25,20 @@ namespace
     "                                          and documentation\n"
     "       immersed-grains --help\n";
 
+  // Runs the scene, or with @p check_only parses, places and estimates it
+  // and prints its regime without writing anything.
   template <int dim>
   void
-  run_scene(const std::string &file)
+  run_scene(const std::string &file, const bool check_only)
   {
     dealii::ParameterHandler prm;
     ImmersedGrains::Simulation<dim>::declare_parameters(prm);
     ImmersedGrains::parse_parameter_file(prm, file);
     ImmersedGrains::Simulation<dim> simulation(prm, file, MPI_COMM_WORLD);
-    simulation.run();
-  }
-
-  template <int dim>
-  void
-  check_scene(const std::string &file)
-  {
-    dealii::ParameterHandler prm;
-    ImmersedGrains::Simulation<dim>::declare_parameters(prm);
-    ImmersedGrains::parse_parameter_file(prm, file);
-    const ImmersedGrains::Simulation<dim> simulation(prm, file, MPI_COMM_WORLD);
-    simulation.print_check(std::cout);
+    if (check_only)
+      simulation.print_check(std::cout);
+    else
+      simulation.run();
   }
 
   template <int dim>
@@ -89,31 +83,21 @@ main(int argc, char **argv)
         (dim == "2" ? print_parameters<2>() : print_parameters<3>());
       return 0;
     }
-    if (args[0] == "--check")
-    {
-      if (args.size() != 2)
-        throw std::runtime_error("--check takes one scene file");
-      const std::string  file = args[1];
-      const unsigned int dim  = ImmersedGrains::read_dimension(file);
-      if (dim == 2)
-        check_scene<2>(file);
-      else
-        check_scene<3>(file);
-      return 0;
-    }
-    if (args.size() != 1 || args[0].rfind("-", 0) == 0)
+    const bool check_only = args[0] == "--check";
+    if (check_only ? args.size() != 2 :
+                     args.size() != 1 || args[0].rfind("-", 0) == 0)
     {
       if (root)
         std::cerr << usage;
       return 1;
     }
 
-    const std::string  file = args[0];
+    const std::string  file = args.back();
     const unsigned int dim  = ImmersedGrains::read_dimension(file);
     if (dim == 2)
-      run_scene<2>(file);
+      run_scene<2>(file, check_only);
     else
-      run_scene<3>(file);
+      run_scene<3>(file, check_only);
   }
   catch (const ImmersedGrains::InputError &e)
   {

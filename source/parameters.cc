@@ -80,46 +80,77 @@ namespace ImmersedGrains
   }
 
 
+  namespace
+  {
+    // A "set" statement of a parameter file, found by a plain text scan
+    // before (or beside) ParameterHandler: its subsections joined by '/',
+    // its name and value as written.
+    struct SetStatement
+    {
+      std::string path;
+      std::string name;
+      std::string value;
+      bool        has_value;
+    };
+
+    std::vector<SetStatement>
+    set_statements(const std::string &file)
+    {
+      std::ifstream in(file);
+      if (!in)
+        throw InputError(file,
+                         "(file)",
+                         file,
+                         "cannot open the parameter file");
+      std::vector<std::string>  path;
+      std::vector<SetStatement> statements;
+      std::string               line;
+      while (std::getline(in, line))
+      {
+        const auto hash = line.find('#');
+        if (hash != std::string::npos)
+          line.erase(hash);
+        std::istringstream words(line);
+        std::string        first, rest;
+        words >> first;
+        std::getline(words, rest);
+        if (first == "subsection")
+          path.push_back(dealii::Utilities::trim(rest));
+        else if (first == "end" && !path.empty())
+          path.pop_back();
+        else if (first == "set")
+        {
+          const auto   eq = rest.find('=');
+          SetStatement statement;
+          for (const auto &section : path)
+            statement.path += (statement.path.empty() ? "" : "/") + section;
+          statement.name      = dealii::Utilities::trim(rest.substr(0, eq));
+          statement.has_value = eq != std::string::npos;
+          if (statement.has_value)
+            statement.value = dealii::Utilities::trim(rest.substr(eq + 1));
+          statements.push_back(statement);
+        }
+      }
+      return statements;
+    }
+  } // namespace
+
+
   unsigned int
   read_dimension(const std::string &file)
   {
-    std::ifstream in(file);
-    if (!in)
-      throw InputError(file, "(file)", file, "cannot open the parameter file");
-
     // Only the top level counts: a "set Dimension" inside a subsection
     // would be an error that ParameterHandler reports later.
-    int         depth = 0;
-    std::string line;
-    while (std::getline(in, line))
-    {
-      const auto hash = line.find('#');
-      if (hash != std::string::npos)
-        line.erase(hash);
-      std::istringstream words(line);
-      std::string        first;
-      words >> first;
-      if (first == "subsection")
-        ++depth;
-      else if (first == "end")
-        --depth;
-      else if (first == "set" && depth == 0)
+    for (const auto &statement : set_statements(file))
+      if (statement.path.empty() && statement.has_value &&
+          statement.name == "Dimension")
       {
-        std::string rest;
-        std::getline(words, rest);
-        const auto eq = rest.find('=');
-        if (eq == std::string::npos)
-          continue;
-        if (dealii::Utilities::trim(rest.substr(0, eq)) != "Dimension")
-          continue;
-        const std::string value = dealii::Utilities::trim(rest.substr(eq + 1));
-        if (value == "2")
+        if (statement.value == "2")
           return 2;
-        if (value == "3")
+        if (statement.value == "3")
           return 3;
-        throw InputError(file, "Dimension", value, "must be 2 or 3");
+        throw InputError(file, "Dimension", statement.value, "must be 2 or 3");
       }
-    }
     return 2;
   }
 
@@ -127,34 +158,10 @@ namespace ImmersedGrains
   std::vector<std::string>
   entries_set_in(const std::string &file)
   {
-    std::ifstream in(file);
-    if (!in)
-      throw InputError(file, "(file)", file, "cannot open the parameter file");
-    std::vector<std::string> path, entries;
-    std::string              line;
-    while (std::getline(in, line))
-    {
-      const auto hash = line.find('#');
-      if (hash != std::string::npos)
-        line.erase(hash);
-      std::istringstream words(line);
-      std::string        first;
-      words >> first;
-      std::string rest;
-      std::getline(words, rest);
-      if (first == "subsection")
-        path.push_back(dealii::Utilities::trim(rest));
-      else if (first == "end" && !path.empty())
-        path.pop_back();
-      else if (first == "set")
-      {
-        const auto  eq = rest.find('=');
-        std::string entry;
-        for (const auto &section : path)
-          entry += section + "/";
-        entries.push_back(entry + dealii::Utilities::trim(rest.substr(0, eq)));
-      }
-    }
+    std::vector<std::string> entries;
+    for (const auto &statement : set_statements(file))
+      entries.push_back((statement.path.empty() ? "" : statement.path + "/") +
+                        statement.name);
     return entries;
   }
 
