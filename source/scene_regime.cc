@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 namespace ImmersedGrains
@@ -71,8 +72,8 @@ namespace ImmersedGrains
     {
       // The lone grain's terminal velocity under the scene's drag law.
       const auto   law    = DragLaw::create(coupling_parameters.drag_law);
-      const double volume = dim == 2 ? M_PI * r * r : 4. / 3 * M_PI * r * r * r;
-      const double area   = dim == 2 ? 2 * r : M_PI * r * r;
+      const double volume = grain_volume<dim>(r);
+      const double area   = grain_projected_area<dim>(r);
       const double mass   = grain_parameters.density * volume;
       const double weight =
         std::abs(grain_parameters.density - rho) * volume * g;

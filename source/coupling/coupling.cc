@@ -146,8 +146,7 @@ namespace ImmersedGrains
       , drag_law(DragLaw::create(parameters.drag_law))
       , self_disturbance(parameters.drag_distribution,
                          parameters.projection.smoothing_length,
-                         parameters.projection.lumped,
-                         geometry.upper_corner[0] - geometry.lower_corner[0])
+                         parameters.projection.lumped)
   {
     if (parameters.drag_distribution == "filtered" ||
         (parameters.two_way && parameters.implicit_coupling))
@@ -257,13 +256,6 @@ namespace ImmersedGrains
         f(cell, first, index);
       }
     }
-
-    template <int dim>
-    double
-    projected_area(const double r)
-    {
-      return dim == 2 ? 2 * r : M_PI * r * r;
-    }
   } // namespace
 
 
@@ -301,7 +293,7 @@ namespace ImmersedGrains
                             const dealii::Tensor<1, dim> &slip) const
   {
     return {radius,
-            projected_area<dim>(radius),
+            grain_projected_area<dim>(radius),
             grain_volume<dim>(radius),
             fluid_fraction,
             slip.norm(),

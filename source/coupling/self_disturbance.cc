@@ -55,25 +55,13 @@ namespace ImmersedGrains
   template <int dim>
   SelfDisturbance<dim>::SelfDisturbance(const std::string &distribution,
                                         const double       smoothing_length,
-                                        const bool         lumped,
-                                        const double       domain_width)
-      : distribution(distribution)
+                                        const bool         lumped)
+      : kernel(distribution == "cell"     ? Kernel::cell :
+               distribution == "filtered" ? Kernel::filtered :
+                                            Kernel::none)
       , smoothing_length(smoothing_length)
       , lumped(lumped)
-      , domain_width(domain_width)
   {
-  }
-
-
-  template <int dim>
-  double
-  SelfDisturbance<dim>::kernel_constant(const double h) const
-  {
-    if (distribution == "cell")
-      return dim == 3 ? cell_constant_3d : 0.0;
-    if (distribution == "filtered")
-      return dim == 3 ? filtered_constant_3d(smoothing_length / h) : 0.0;
-    return 0.0;
   }
 
 
@@ -83,9 +71,12 @@ namespace ImmersedGrains
                                  const double phi,
                                  const double mu) const
   {
-    if (dim != 3)
+    if (dim != 3 || kernel == Kernel::none)
       return 0.0;
-    return kernel_constant(h) / (phi * mu * h);
+    const double c = kernel == Kernel::cell ?
+                       cell_constant_3d :
+                       filtered_constant_3d(smoothing_length / h);
+    return c / (phi * mu * h);
   }
 
 
@@ -95,9 +86,9 @@ namespace ImmersedGrains
                                       const double kinematic_viscosity) const
   {
     double width_squared = 0;
-    if (distribution == "cell")
+    if (kernel == Kernel::cell)
       width_squared = 0.60 * h * h;
-    else if (distribution == "filtered")
+    else if (kernel == Kernel::filtered)
       width_squared = 1.14 * h * h + 9.4 * smoothing_length * smoothing_length;
     return width_squared / kinematic_viscosity;
   }

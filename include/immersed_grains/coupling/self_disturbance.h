@@ -26,8 +26,8 @@ namespace ImmersedGrains
    *   evaluated once for a unit cell (cell spread: the cell's indicator;
    *   filtered: the Q1 hat times the Helmholtz filter 1 / (1 + l^2 k^2)),
    *   so that K = c(l/h) / (phi mu h) in 3D. In 2D the integral diverges
-   *   logarithmically (a disc's Stokeslet), and K = (ln(L/h) + c) /
-   *   (4 pi phi mu), L the domain's width across the fall.
+   *   logarithmically with the box (a disc's Stokeslet): K is not modelled
+   *   there and is 0.
    *
    * K depends only on the distribution and the cell: no constant in it is
    * fitted to a run (benchmarks/self_disturbance/ reproduces the
@@ -50,12 +50,11 @@ namespace ImmersedGrains
     /**
      * @p distribution "cell", "filtered" or "point" (no velocity model:
      * K = 0); @p smoothing_length the filter's l; @p lumped the
-     * projection's mass matrix; @p domain_width the 2D L.
+     * projection's mass matrix.
      */
     SelfDisturbance(const std::string &distribution,
                     double             smoothing_length,
-                    bool               lumped,
-                    double             domain_width);
+                    bool               lumped);
 
     /** K [s/kg] for a grain in a cell of size @p h at fluid fraction
      *  @p phi in a fluid of viscosity @p mu. */
@@ -77,16 +76,16 @@ namespace ImmersedGrains
                        double                    h,
                        double                    volume) const;
 
-    /** K mu h (3D) or the 2D constant c for the chosen distribution and
-     *  l/h: the kernel integral, for the log and tests. */
-    double
-    kernel_constant(double h) const;
-
   private:
-    const std::string distribution;
-    const double      smoothing_length;
-    const bool        lumped;
-    const double      domain_width;
+    enum class Kernel
+    {
+      cell,     // the cell's indicator
+      filtered, // the Q1 hat times the Helmholtz filter
+      none      // the point distribution: not modelled
+    };
+    const Kernel kernel;
+    const double smoothing_length;
+    const bool   lumped;
   };
 } // namespace ImmersedGrains
 

@@ -104,6 +104,15 @@ namespace ImmersedGrains
     return dim == 2 ? M_PI * r * r : 4. / 3. * M_PI * r * r * r;
   }
 
+  /** Area a grain of radius r shows the flow: 2 r (disc per unit depth) in
+   *  2D, pi r^2 in 3D. */
+  template <int dim>
+  inline double
+  grain_projected_area(const double r)
+  {
+    return dim == 2 ? 2 * r : M_PI * r * r;
+  }
+
   /** Moment of inertia per unit mass, I / m: r^2/2 disc, 2 r^2/5 sphere. */
   template <int dim>
   inline double
