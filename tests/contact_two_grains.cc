@@ -264,16 +264,29 @@ namespace
              std::max((g.velocity[0] + n).norm(), (g.velocity[1] - n).norm()),
              1e-14);
     }
-    // An overlap at rest is removed within one step, without restitution.
+    // An overlap at rest beyond the tolerance is reduced to half the
+    // tolerance within one step by moving the grains
+    // (GrainArrays::position_correction), which leave it without speed:
+    // pushing them apart would give them |gap|/dt.
     {
-      const double     overlap = 1e-3;
+      const double     overlap = 1e-3; // twice the limit, 1e-3 r_min
       GrainArrays<dim> g =
         two_grains<dim>(2., 3., Tensor<1, dim>(), Tensor<1, dim>());
       collide(g, -overlap, 1., 0.);
-      const double end_gap =
-        -overlap + dt * (g.velocity[1] - g.velocity[0]) * n;
-      std::snprintf(name, sizeof(name), "%dD overlap removed in one step", dim);
-      report(name, std::abs(end_gap) / overlap, 1e-10);
+      const double limit = ContactParameters().overlap_tolerance * 0.5;
+      double end_gap     = -overlap + dt * (g.velocity[1] - g.velocity[0]) * n;
+      if (!g.position_correction.empty())
+        end_gap += (g.position_correction[1] - g.position_correction[0]) * n;
+      std::snprintf(name,
+                    sizeof(name),
+                    "%dD overlap down to half the limit in one step",
+                    dim);
+      report(name, std::abs(end_gap + 0.5 * limit) / overlap, 1e-10);
+      std::snprintf(name,
+                    sizeof(name),
+                    "%dD ... the grains keep no speed",
+                    dim);
+      report(name, std::max(g.velocity[0].norm(), g.velocity[1].norm()), 1e-14);
     }
   }
 

@@ -327,7 +327,7 @@ namespace ImmersedGrains
       m.max_change     = std::sqrt(max_d2);
       m.max_impulse    = std::sqrt(max_p2);
       m.max_overlap    = overlap;
-      m.overlap_excess = overlap - overlap_limit();
+      m.overlap_excess = overlap - allowed_overlap();
       return m;
     }
 
@@ -337,7 +337,7 @@ namespace ImmersedGrains
     bool
     ContactSolver<dim>::apgd_accept(const AcceleratedMeasures &global)
     {
-      const bool        friction = (parameters.friction > 0);
+      const bool        friction = with_friction();
       const unsigned    c        = (friction ? dim : 1);
       const std::size_t n_rows   = rows.size();
       // The step-size test, with room for round-off in d.N d, which is a
@@ -411,7 +411,7 @@ namespace ImmersedGrains
       const std::function<void()>                      &glue,
       const std::function<void(AcceleratedMeasures &)> &reduce)
     {
-      const bool   friction = (parameters.friction > 0);
+      const bool   friction = with_friction();
       SolverResult result;
       result.n_contacts = rows.size();
 

@@ -367,6 +367,7 @@ namespace ImmersedGrains
     cut(g.radius);
     cut(g.id);
     cut(g.sweep_key);
+    cut(g.position_correction);
     for (unsigned int i = 0; i < n_owned; ++i)
       if (multiplicity.size() == n_owned && multiplicity[i] > 1)
       {
@@ -415,81 +416,96 @@ namespace ImmersedGrains
     if (n_ranks > 1)
       keep_own_contacts();
 
-    const auto           &prm = solver.get_parameters();
-    Contact::SolverResult result;
+    const auto &prm = solver.get_parameters();
     solver.setup(pairs, wall_contacts, walls.velocities(), g, dt);
     glue_copies();
-    bool   converged = false;
-    double overlap   = 0;
-    if (prm.method == Contact::ContactMethod::apgd)
+
+    // One phase, the velocities or the position correction: the same
+    // iterations on every rank, which stop together.
+    const auto iterate = [&]()
     {
-      // One glue and two reductions per iteration: APGD's gradient needs
-      // the velocities of the global iterate.
-      const auto reduce = [&](Contact::AcceleratedMeasures &m)
+      Contact::SolverResult result;
+      if (prm.method == Contact::ContactMethod::apgd)
       {
-        if (n_ranks == 1)
-          return;
-        const double sums[3]   = {m.curvature, m.metric, m.restart};
-        const double maxima[4] = {m.max_change,
-                                  m.max_impulse,
-                                  m.max_overlap,
-                                  m.overlap_excess};
-        double       s[3], x[4];
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 3),
-                                    comm,
-                                    dealii::ArrayView<double>(s, 3));
-        dealii::Utilities::MPI::max(dealii::ArrayView<const double>(maxima, 4),
-                                    comm,
-                                    dealii::ArrayView<double>(x, 4));
-        m.curvature      = s[0];
-        m.metric         = s[1];
-        m.restart        = s[2];
-        m.max_change     = x[0];
-        m.max_impulse    = x[1];
-        m.max_overlap    = x[2];
-        m.overlap_excess = x[3];
-      };
-      result    = solver.iterate_accelerated([&]() { glue_copies(); }, reduce);
-      converged = result.converged;
-    }
-    while (!converged && result.iterations < prm.max_iterations &&
-           prm.method == Contact::ContactMethod::gauss_seidel)
+        // One glue and two reductions per iteration: APGD's gradient needs
+        // the velocities of the global iterate.
+        const auto reduce = [&](Contact::AcceleratedMeasures &m)
+        {
+          if (n_ranks == 1)
+            return;
+          const double sums[3]   = {m.curvature, m.metric, m.restart};
+          const double maxima[4] = {m.max_change,
+                                    m.max_impulse,
+                                    m.max_overlap,
+                                    m.overlap_excess};
+          double       s[3], x[4];
+          dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums, 3),
+                                      comm,
+                                      dealii::ArrayView<double>(s, 3));
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(maxima,
+                                                                      4),
+                                      comm,
+                                      dealii::ArrayView<double>(x, 4));
+          m.curvature      = s[0];
+          m.metric         = s[1];
+          m.restart        = s[2];
+          m.max_change     = x[0];
+          m.max_impulse    = x[1];
+          m.max_overlap    = x[2];
+          m.overlap_excess = x[3];
+        };
+        return solver.iterate_accelerated([&]() { glue_copies(); }, reduce);
+      }
+      while (!result.converged && result.iterations < prm.max_iterations)
+      {
+        // Several local sweeps per exchange: on a rank boundary information
+        // then crosses once per batch, but the messages and the reduction,
+        // whose latency dominates on loaded machines, are paid once.
+        // The largest change over the batch: its first sweep is the one
+        // that sees what the last glue did to the copies, so a batch
+        // converges only once gluing no longer disturbs the contacts.
+        Contact::SweepResult s;
+        for (unsigned int q = 0; q < (n_ranks > 1 ? sweeps_per_exchange : 1) &&
+                                 result.iterations < prm.max_iterations;
+             ++q)
+        {
+          const Contact::SweepResult t = solver.sweep();
+          s.max_change                 = std::max(s.max_change, t.max_change);
+          s.max_impulse                = std::max(s.max_impulse, t.max_impulse);
+          ++result.iterations;
+        }
+        glue_copies();
+        if (n_ranks > 1)
+        {
+          double local[2] = {s.max_change, s.max_impulse}, global[2];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 2),
+                                      comm,
+                                      dealii::ArrayView<double>(global, 2));
+          s.max_change  = global[0];
+          s.max_impulse = global[1];
+        }
+        result.residual = s.max_impulse > 0 ? s.max_change / s.max_impulse : 0;
+        if (s.max_change <= prm.tolerance * s.max_impulse)
+          result.converged = dealii::Utilities::MPI::min(
+            int(solver.converged(s, solver.predicted_max_overlap())), comm);
+      }
+      return result;
+    };
+
+    Contact::SolverResult result = iterate();
+    // Overlaps beyond the limit are removed by moving grains, not by
+    // pushing them apart (ContactSolver::begin_position_correction()).
+    double overlap = solver.end_of_step_overlap();
+    if (dealii::Utilities::MPI::max(int(overlap > solver.overlap_limit()),
+                                    comm))
     {
-      // Several local sweeps per exchange: on a rank boundary information
-      // then crosses once per batch, but the messages and the reduction,
-      // whose latency dominates on loaded machines, are paid once.
-      // The largest change over the batch: its first sweep is the one that
-      // sees what the last glue did to the copies, so a batch converges
-      // only once gluing no longer disturbs the contacts.
-      Contact::SweepResult s;
-      for (unsigned int q = 0; q < (n_ranks > 1 ? sweeps_per_exchange : 1) &&
-                               result.iterations < prm.max_iterations;
-           ++q)
-      {
-        const Contact::SweepResult t = solver.sweep();
-        s.max_change                 = std::max(s.max_change, t.max_change);
-        s.max_impulse                = std::max(s.max_impulse, t.max_impulse);
-        ++result.iterations;
-      }
-      glue_copies();
-      if (n_ranks > 1)
-      {
-        double local[2] = {s.max_change, s.max_impulse}, global[2];
-        dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 2),
-                                    comm,
-                                    dealii::ArrayView<double>(global, 2));
-        s.max_change  = global[0];
-        s.max_impulse = global[1];
-      }
-      result.residual = s.max_impulse > 0 ? s.max_change / s.max_impulse : 0;
-      if (s.max_change <= prm.tolerance * s.max_impulse)
-      {
-        overlap = solver.predicted_max_overlap();
-        converged =
-          dealii::Utilities::MPI::min(int(solver.converged(s, overlap)), comm);
-      }
+      solver.begin_position_correction();
+      const Contact::SolverResult correction = iterate();
+      result.iterations += correction.iterations;
+      result.converged = result.converged && correction.converged;
+      result.residual  = std::max(result.residual, correction.residual);
+      overlap          = solver.predicted_max_overlap();
     }
-    overlap = solver.predicted_max_overlap();
     solver.finish(g);
     drop_ghosts(g);
 
@@ -498,7 +514,6 @@ namespace ImmersedGrains
       active += (p > 0);
     for (const double p : solver.wall_impulses().normal)
       active += (p > 0);
-    result.converged   = converged;
     result.max_overlap = dealii::Utilities::MPI::max(overlap, comm);
     result.n_contacts  = dealii::Utilities::MPI::sum(
       static_cast<unsigned int>(pairs.size() + wall_contacts.size()), comm);

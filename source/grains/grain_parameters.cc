@@ -156,7 +156,8 @@ namespace ImmersedGrains
                         "1000",
                         Integer(1),
                         "Cap on Gauss-Seidel sweeps (or APGD iterations) per "
-                        "step.");
+                        "step, and again for the position correction when a "
+                        "step needs one (doc/contacts.md).");
       prm.declare_entry("Alert distance",
                         "0",
                         Double(0),

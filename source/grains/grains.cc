@@ -580,7 +580,9 @@ namespace ImmersedGrains
     {
       const bool         fixed = arrays.fixed[i];
       dealii::Point<dim> x     = arrays.position[i] + dt * c.velocity[i];
-      bool               left  = false;
+      if (!c.position_correction.empty())
+        x += c.position_correction[i];
+      bool left = false;
       for (unsigned int d = 0; d < dim && !fixed; ++d)
       {
         const double L = hi[d] - lo[d];

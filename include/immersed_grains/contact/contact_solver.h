@@ -55,6 +55,12 @@ namespace ImmersedGrains
       /// survives reordering. If empty, the index is the id.
       std::vector<std::uint64_t> id;
 
+      /// Out (ContactSolver::finish()): the displacement [m] the position
+      /// correction adds to x + dt v this step, one per grain; empty when
+      /// the step needed none. It moves the grains without giving them
+      /// velocity (ContactSolver::begin_position_correction()).
+      std::vector<Tensor<1, dim>> position_correction;
+
       /// Optional sweep key per grain, e.g. the height against gravity:
       /// forward sweeps visit the contacts in increasing key of their
       /// midpoint, backward sweeps in decreasing key (see
@@ -219,11 +225,47 @@ namespace ImmersedGrains
       sweep();
 
       /// Largest -(g + dt u_n) over the contacts, with the current
-      /// velocities: the overlap the position update would leave.
+      /// velocities and the gap g of the current phase: while solving for
+      /// the velocities, the overlap the step adds to what it started with
+      /// (g = max(gap, 0)); while correcting positions, the overlap the
+      /// step leaves. converged() holds it to half the overlap limit in the
+      /// first case, to the limit in the second.
       double
       predicted_max_overlap() const;
 
-      /// The overlap converged() accepts, in metres.
+      /// Largest overlap the step would leave without a position
+      /// correction, -(gap + dt u_n) with the gaps at the start of the step
+      /// and the current velocities.
+      double
+      end_of_step_overlap() const;
+
+      /**
+       * After the velocity iterations, when end_of_step_overlap() exceeds
+       * overlap_limit() on some rank: keeps the velocities and impulses
+       * found, and poses the position correction, the same contact problem
+       * for pseudo-velocities z (all zero to begin with, no friction) that
+       * bring every overlap down to half the limit,
+       * dt z_n >= -(gap + dt u_n) - overlap_limit() / 2. The caller iterates
+       * again exactly as for the velocities (sweep() and converged(), or
+       * iterate_accelerated()); finish() then returns dt z as
+       * GrainArrays::position_correction and the velocities of the first
+       * solve. The correction moves grains without giving them velocity, so
+       * a solve's error never comes back as a push that separates grains:
+       * removing overlaps through the velocities instead feeds every
+       * step's error back twice over, and a pile whose slowest modes the
+       * solver damps by less than half per step never comes to rest
+       * (doc/contacts.md, "Coming to rest").
+       */
+      void
+      begin_position_correction();
+
+      /// Between begin_position_correction() and finish().
+      bool
+      correcting_positions() const;
+
+      /// The largest overlap a step may leave, in metres:
+      /// ContactParameters::overlap_tolerance times the smallest radius in
+      /// contact.
       double
       overlap_limit() const;
 
@@ -333,9 +375,15 @@ namespace ImmersedGrains
       std::vector<SpinSlot>    spins;
       std::vector<Row>         rows;
       std::vector<FrictionRow> friction_rows;
-      std::vector<double>      gaps;
-      std::vector<Key>         keys;     // warm-start key of each row
-      std::vector<double>      key_sign; // -1 where the key swapped the pair
+      std::vector<double>      gaps;       // of the current phase
+      std::vector<double>      start_gaps; // at the start of the step
+
+      // The velocity solution kept while the positions are corrected.
+      bool                   correcting = false;
+      std::vector<GrainSlot> solved_grains;
+      std::vector<double>    solved_p_n;
+      std::vector<Key>       keys;     // warm-start key of each row
+      std::vector<double>    key_sign; // -1 where the key swapped the pair
 
       std::vector<CachedImpulse> cache;
 
@@ -361,6 +409,16 @@ namespace ImmersedGrains
 
       ContactImpulses<dim> pair_results;
       ContactImpulses<dim> wall_results;
+
+      /// What predicted_max_overlap() may reach for converged(): half the
+      /// limit while solving for the velocities, the limit while
+      /// correcting positions.
+      double
+      allowed_overlap() const;
+
+      /// Friction acts in the velocity solve only.
+      bool
+      with_friction() const;
 
       void
       order_rows(const std::vector<GrainPair<dim>>   &pairs,
