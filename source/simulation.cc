@@ -880,6 +880,11 @@ namespace ImmersedGrains
       print_test_checks(std::cout, test_checks, statistics);
 
     print_progress(true);
+    if (capped_contact_steps > 0)
+      pcout << "  note: the contact solver stopped at Contacts/Max "
+            << "iterations in " << capped_contact_steps << " step"
+            << (capped_contact_steps > 1 ? "s" : "")
+            << " of this run (contact_converged = 0 in statistics.csv)\n";
     pcout << "  done: " << step << " steps, wall time " << now() - wall_start
           << " s; output in " << output_directory << "/\n";
     timer->print_wall_time_statistics(comm);
@@ -1045,10 +1050,20 @@ namespace ImmersedGrains
       statistics.set("contact_converged", c.converged);
       statistics.set("max_contact_force", report.max_contact_force);
       statistics.set("alert_distance", report.alert_distance);
-      if (!c.converged && grain_parameters.contacts_enabled)
+      // A deep bed can meet the cap on many steps: the first few are
+      // worth a line each, the rest a count at the end and the column
+      // contact_converged.
+      constexpr unsigned int warnings_shown = 5;
+      if (!c.converged && grain_parameters.contacts_enabled &&
+          ++capped_contact_steps <= warnings_shown)
         pcout << "  warning: step " << step << ": the contact solver stopped "
               << "after " << c.iterations << " sweeps, residual " << c.residual
-              << ", overlap " << c.max_overlap << " m\n";
+              << ", overlap " << c.max_overlap << " m"
+              << (capped_contact_steps == warnings_shown ?
+                    " (no more such lines; contact_converged = 0 in "
+                    "statistics.csv marks every such step)" :
+                    "")
+              << "\n";
     }
   }
 

@@ -160,6 +160,8 @@ namespace ImmersedGrains
     std::string                     pressure_drop_text;
     unsigned int                    clamped_nodes_before  = 0;
     unsigned int                    preconditioner_builds = 0;
+    // Steps whose contact solve stopped at Contacts/Max iterations.
+    unsigned int capped_contact_steps = 0;
 
     Geometry<dim>                           geometry;
     FluidParameters<dim>                    fluid_parameters;

@@ -741,22 +741,37 @@ namespace ImmersedGrains
 
     template <int dim>
     double
-    ContactSolver<dim>::predicted_max_overlap() const
+    ContactSolver<dim>::normal_velocity(const Row &row) const
+    {
+      double u_n = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        u_n += (grains[row.j].velocity[d] - grains[row.i].velocity[d]) *
+               row.normal[d];
+      return u_n;
+    }
+
+
+
+    template <int dim>
+    double
+    ContactSolver<dim>::max_overlap_from(const std::vector<double> &from) const
     {
       double overlap = 0;
       for (unsigned int k = 0; k < rows.size(); ++k)
-      {
-        const Row &row = rows[k];
         // Between two fixed grains nothing can be done: not our failure.
-        if (row.inverse_w == 0)
-          continue;
-        double u_n = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          u_n += (grains[row.j].velocity[d] - grains[row.i].velocity[d]) *
-                 row.normal[d];
-        overlap = std::max(overlap, -(gaps[k] + dt * u_n));
-      }
+        if (rows[k].inverse_w > 0)
+          overlap =
+            std::max(overlap, -(from[k] + dt * normal_velocity(rows[k])));
       return overlap;
+    }
+
+
+
+    template <int dim>
+    double
+    ContactSolver<dim>::predicted_max_overlap() const
+    {
+      return max_overlap_from(gaps);
     }
 
 
@@ -765,19 +780,7 @@ namespace ImmersedGrains
     double
     ContactSolver<dim>::end_of_step_overlap() const
     {
-      double overlap = 0;
-      for (unsigned int k = 0; k < rows.size(); ++k)
-      {
-        const Row &row = rows[k];
-        if (row.inverse_w == 0)
-          continue;
-        double u_n = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          u_n += (grains[row.j].velocity[d] - grains[row.i].velocity[d]) *
-                 row.normal[d];
-        overlap = std::max(overlap, -(start_gaps[k] + dt * u_n));
-      }
-      return overlap;
+      return max_overlap_from(start_gaps);
     }
 
 
@@ -799,14 +802,10 @@ namespace ImmersedGrains
       solved_p_n.resize(rows.size());
       for (unsigned int k = 0; k < rows.size(); ++k)
       {
-        Row   &row = rows[k];
-        double u_n = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          u_n += (grains[row.j].velocity[d] - grains[row.i].velocity[d]) *
-                 row.normal[d];
+        Row &row      = rows[k];
         solved_p_n[k] = row.p_n;
         // The gap the velocities leave; walls have moved with them.
-        gaps[k]    = start_gaps[k] + dt * u_n;
+        gaps[k]    = start_gaps[k] + dt * normal_velocity(row);
         row.target = -(gaps[k] + kept_overlap) / dt;
         row.p_n    = 0;
       }

@@ -410,6 +410,14 @@ namespace ImmersedGrains
       ContactImpulses<dim> pair_results;
       ContactImpulses<dim> wall_results;
 
+      /// u_n = (v_j - v_i).n with the working velocities.
+      double
+      normal_velocity(const Row &row) const;
+
+      /// Largest -(from[k] + dt u_n) over the rows with a free grain.
+      double
+      max_overlap_from(const std::vector<double> &from) const;
+
       /// What predicted_max_overlap() may reach for converged(): half the
       /// limit while solving for the velocities, the limit while
       /// correcting positions.
