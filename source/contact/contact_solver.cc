@@ -195,9 +195,27 @@ namespace ImmersedGrains
         return result;
       };
 
+      SolverResult result =
+        iterate_phases(iterate, [](const bool needed) { return needed; });
+      result.n_contacts = rows.size();
+
+      finish(grain_arrays);
+      for (const Row &row : rows)
+        result.n_active += (row.p_n > 0);
+      return result;
+    }
+
+
+
+    template <int dim>
+    SolverResult
+    ContactSolver<dim>::iterate_phases(
+      const std::function<SolverResult()> &iterate,
+      const std::function<bool(bool)>     &on_any_rank)
+    {
       SolverResult result = iterate();
       result.max_overlap  = end_of_step_overlap();
-      if (result.max_overlap > overlap_limit())
+      if (on_any_rank(result.max_overlap > overlap_limit()))
       {
         begin_position_correction();
         const SolverResult correction = iterate();
@@ -206,11 +224,6 @@ namespace ImmersedGrains
         result.residual    = std::max(result.residual, correction.residual);
         result.max_overlap = correction.max_overlap;
       }
-      result.n_contacts = rows.size();
-
-      finish(grain_arrays);
-      for (const Row &row : rows)
-        result.n_active += (row.p_n > 0);
       return result;
     }
 
@@ -813,15 +826,6 @@ namespace ImmersedGrains
         for (unsigned int d = 0; d < dim; ++d)
           slot.velocity[d] = 0;
       forward = true;
-    }
-
-
-
-    template <int dim>
-    bool
-    ContactSolver<dim>::correcting_positions() const
-    {
-      return correcting;
     }
 
 

@@ -489,23 +489,18 @@ namespace ImmersedGrains
           result.converged = dealii::Utilities::MPI::min(
             int(solver.converged(s, solver.predicted_max_overlap())), comm);
       }
+      result.max_overlap = solver.predicted_max_overlap();
       return result;
     };
 
-    Contact::SolverResult result = iterate();
     // Overlaps beyond the limit are removed by moving grains, not by
-    // pushing them apart (ContactSolver::begin_position_correction()).
-    double overlap = solver.end_of_step_overlap();
-    if (dealii::Utilities::MPI::max(int(overlap > solver.overlap_limit()),
-                                    comm))
-    {
-      solver.begin_position_correction();
-      const Contact::SolverResult correction = iterate();
-      result.iterations += correction.iterations;
-      result.converged = result.converged && correction.converged;
-      result.residual  = std::max(result.residual, correction.residual);
-      overlap          = solver.predicted_max_overlap();
-    }
+    // pushing them apart (ContactSolver::iterate_phases()).
+    Contact::SolverResult result =
+      solver.iterate_phases(iterate,
+                            [&](const bool needed) {
+                              return dealii::Utilities::MPI::max(int(needed),
+                                                                 comm) == 1;
+                            });
     solver.finish(g);
     drop_ghosts(g);
 
@@ -514,7 +509,7 @@ namespace ImmersedGrains
       active += (p > 0);
     for (const double p : solver.wall_impulses().normal)
       active += (p > 0);
-    result.max_overlap = dealii::Utilities::MPI::max(overlap, comm);
+    result.max_overlap = dealii::Utilities::MPI::max(result.max_overlap, comm);
     result.n_contacts  = dealii::Utilities::MPI::sum(
       static_cast<unsigned int>(pairs.size() + wall_contacts.size()), comm);
     result.n_active = dealii::Utilities::MPI::sum(active, comm);

@@ -233,35 +233,19 @@ namespace ImmersedGrains
       double
       predicted_max_overlap() const;
 
-      /// Largest overlap the step would leave without a position
-      /// correction, -(gap + dt u_n) with the gaps at the start of the step
-      /// and the current velocities.
-      double
-      end_of_step_overlap() const;
-
       /**
-       * After the velocity iterations, when end_of_step_overlap() exceeds
-       * overlap_limit() on some rank: keeps the velocities and impulses
-       * found, and poses the position correction, the same contact problem
-       * for pseudo-velocities z (all zero to begin with, no friction) that
-       * bring every overlap down to half the limit,
-       * dt z_n >= -(gap + dt u_n) - overlap_limit() / 2. The caller iterates
-       * again exactly as for the velocities (sweep() and converged(), or
-       * iterate_accelerated()); finish() then returns dt z as
-       * GrainArrays::position_correction and the velocities of the first
-       * solve. The correction moves grains without giving them velocity, so
-       * a solve's error never comes back as a push that separates grains:
-       * removing overlaps through the velocities instead feeds every
-       * step's error back twice over, and a pile whose slowest modes the
-       * solver damps by less than half per step never comes to rest
-       * (doc/contacts.md, "Coming to rest").
+       * After setup(): the velocity iterations, then, where the step would
+       * leave an overlap beyond overlap_limit(), the position correction
+       * (begin_position_correction()). @p iterate runs one phase's
+       * iterations (sweeps with converged(), or iterate_accelerated(), with
+       * the caller's communication) and returns its result with the
+       * predicted overlap; @p on_any_rank turns this rank's "a correction
+       * is needed" into the answer of all ranks, so that all correct or
+       * none. Returns the two phases added up. Call finish() afterwards.
        */
-      void
-      begin_position_correction();
-
-      /// Between begin_position_correction() and finish().
-      bool
-      correcting_positions() const;
+      SolverResult
+      iterate_phases(const std::function<SolverResult()> &iterate,
+                     const std::function<bool(bool)>     &on_any_rank);
 
       /// The largest overlap a step may leave, in metres:
       /// ContactParameters::overlap_tolerance times the smallest radius in
@@ -423,6 +407,31 @@ namespace ImmersedGrains
       /// correcting positions.
       double
       allowed_overlap() const;
+
+      /// Largest overlap the step would leave without a position
+      /// correction, -(gap + dt u_n) with the gaps at the start of the step
+      /// and the current velocities.
+      double
+      end_of_step_overlap() const;
+
+      /**
+       * After the velocity iterations, when end_of_step_overlap() exceeds
+       * overlap_limit() on some rank (iterate_phases()): keeps the velocities
+       * and impulses found, and poses the position correction, the same contact
+       * problem for pseudo-velocities z (all zero to begin with, no friction)
+       * that bring every overlap down to half the limit, dt z_n >= -(gap + dt
+       * u_n) - overlap_limit() / 2. iterate_phases() iterates again exactly as
+       * for the velocities; finish() then returns dt z as
+       * GrainArrays::position_correction and the velocities of the first
+       * solve. The correction moves grains without giving them velocity, so
+       * a solve's error never comes back as a push that separates grains:
+       * removing overlaps through the velocities instead feeds every
+       * step's error back twice over, and a pile whose slowest modes the
+       * solver damps by less than half per step never comes to rest
+       * (doc/contacts.md, "Coming to rest").
+       */
+      void
+      begin_position_correction();
 
       /// Friction acts in the velocity solve only.
       bool
