@@ -661,6 +661,7 @@ namespace ImmersedGrains
     if (grains)
       grains->prepare_for_serialization();
     triangulation.save(directory + "/mesh");
+    Checkpoint::maybe_die_while_writing(step);
     if (grains)
     {
       std::ofstream out(

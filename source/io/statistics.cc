@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <string>
@@ -28,19 +29,26 @@ namespace ImmersedGrains
       return;
     if (keep_through_step >= 0)
     {
-      std::vector<std::string> kept;
+      // A resumed run keeps the rows up to its checkpoint's step. They are
+      // written to a new file that replaces the old one when complete: a
+      // run killed meanwhile leaves the old rows, not a truncated file.
+      const std::string part = file_name + ".part";
       {
         std::ifstream old(file_name);
+        std::ofstream kept(part);
         std::string   line;
-        std::getline(old, line); // the header
+        std::getline(old, line); // the old header, written anew below
+        for (unsigned int i = 0; i < columns.size(); ++i)
+          kept << (i ? "," : "") << columns[i];
+        kept << '\n';
         while (std::getline(old, line))
           if (!line.empty() && std::stod(line) <= keep_through_step)
-            kept.push_back(line);
+            kept << line << '\n';
+        AssertThrow(kept, dealii::ExcMessage("Cannot write " + part));
       }
-      open(file_name, true);
-      for (const auto &line : kept)
-        file << line << '\n';
-      file.flush();
+      std::filesystem::rename(part, file_name);
+      file.open(file_name, std::ios::app);
+      AssertThrow(file, dealii::ExcMessage("Cannot write " + file_name));
       return;
     }
     file.open(file_name);

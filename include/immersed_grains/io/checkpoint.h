@@ -62,6 +62,13 @@ namespace ImmersedGrains
     std::string
     commit(unsigned int step, double wall_now);
 
+    /** Fault injection for the tests: if the environment variable
+     *  IMMERSED_GRAINS_KILL_DURING_CHECKPOINT names @p step, the process
+     *  kills itself with SIGKILL, as a machine or a batch system would,
+     *  leaving the set it is writing unfinished. */
+    static void
+    maybe_die_while_writing(unsigned int step);
+
   private:
     const Parameters &parameters;
     std::string       directory;
