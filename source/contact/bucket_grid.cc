@@ -16,6 +16,8 @@ namespace ImmersedGrains
         : lower(lower)
         , extent(upper - lower)
         , periodic(periodic)
+        , grid_lower(lower)
+        , grid_extent(upper - lower)
     {
       for (unsigned int d = 0; d < dim; ++d)
       {
@@ -60,7 +62,8 @@ namespace ImmersedGrains
                         "times (largest diameter + alert distance) long, "
                         "else a grain could touch two images of the same "
                         "neighbour."));
-        n[d] = std::max(1., std::min(std::floor(extent[d] / min_size), 1e6));
+        n[d] =
+          std::max(1., std::min(std::floor(grid_extent[d] / min_size), 1e6));
         total *= n[d];
       }
       while (total > max_buckets)
@@ -76,7 +79,7 @@ namespace ImmersedGrains
       for (unsigned int d = 0; d < dim; ++d)
       {
         n_buckets_per_axis[d] = static_cast<unsigned int>(n[d]);
-        bucket_size[d]        = extent[d] / n[d];
+        bucket_size[d]        = grid_extent[d] / n[d];
       }
     }
 
@@ -101,7 +104,7 @@ namespace ImmersedGrains
         unsigned int stride = 1;
         for (unsigned int d = 0; d < dim; ++d)
         {
-          double x = positions[i][d] - lower[d];
+          double x = positions[i][d] - grid_lower[d];
           int    c = 0;
           if (periodic[d])
           {
@@ -167,7 +170,29 @@ namespace ImmersedGrains
         return;
 
       const double max_radius = *std::max_element(radii.begin(), radii.end());
-      choose_buckets(n_grains, 2 * max_radius + alert_distance);
+      const double min_size   = 2 * max_radius + alert_distance;
+      // Buckets over the grains' bounding box within the domain on the
+      // non-periodic axes. Over the whole domain, a cloud of 10,000
+      // spheres in a box 14 cloud radii wide got buckets of 0.3 mm holding
+      // 150 grains each, and this search took 40 % of a coupled run.
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        grid_lower[d]  = lower[d];
+        grid_extent[d] = extent[d];
+        if (periodic[d])
+          continue;
+        double lo = lower[d] + extent[d], hi = lower[d];
+        for (const auto &x : positions)
+        {
+          lo = std::min(lo, x[d]);
+          hi = std::max(hi, x[d]);
+        }
+        lo             = std::max(lo, lower[d]);
+        hi             = std::min(hi, lower[d] + extent[d]);
+        grid_lower[d]  = std::min(lo, hi);
+        grid_extent[d] = std::max(hi - lo, min_size);
+      }
+      choose_buckets(n_grains, min_size);
       sort_grains_into_buckets(positions, radii);
 
       bool any_periodic = false;

@@ -85,6 +85,12 @@ namespace ImmersedGrains
       Tensor<1, dim>        extent;
       std::array<bool, dim> periodic;
 
+      // The box the buckets cover in the last call: on non-periodic axes
+      // the part of [lower, upper] that the grains occupy, so that a cloud
+      // in a large domain gets buckets of its own scale.
+      Point<dim>     grid_lower;
+      Tensor<1, dim> grid_extent;
+
       std::array<unsigned int, dim> n_buckets_per_axis;
       Tensor<1, dim>                bucket_size;
 
