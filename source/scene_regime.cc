@@ -215,8 +215,11 @@ namespace ImmersedGrains
     out << parameter_file << ": checked, nothing written.\n"
         << "  size: " << number(size_estimate.cells) << " cells, "
         << number(size_estimate.dofs) << " fluid DoFs, peak memory about "
-        << number(size_estimate.peak_bytes / (1 << 30)) << " GiB\n"
-        << "  regime:\n";
+        << number(size_estimate.peak_bytes / (1 << 30)) << " GiB"
+        << (size_estimate.adapted ? " (the adaptive mesh around the initial "
+                                    "grains)" :
+                                    "")
+        << "\n  regime:\n";
     for (const auto &l : scene.lines)
       out << "    " << l << '\n';
     out << "  switched:\n";

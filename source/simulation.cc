@@ -352,18 +352,48 @@ namespace ImmersedGrains
 
     // Stop here, before anything large is allocated or written, if the
     // scene cannot fit: the kernel would kill it half-way instead.
-    size_estimate =
-      estimate_size(geometry, fluid_parameters.enabled, grain_seeds.size());
+    // An adaptive mesh is counted as its grain band will make it around
+    // the initial grains: its initial mesh alone says nothing of the
+    // levels it will reach.
+    const bool adapted_estimate = adaptivity_parameters.enabled &&
+                                  adaptivity_parameters.around_grains &&
+                                  !grain_seeds.empty();
+    if (adapted_estimate)
+    {
+      GrainBand band;
+      band.min_level  = adaptivity_parameters.min_level;
+      band.max_level  = adaptivity_parameters.max_level;
+      band.band_width = adaptivity_parameters.band_width;
+      band.smallest_cell =
+        adaptivity_parameters.min_cell_size * 2 * largest_grain_radius;
+      std::vector<dealii::Point<dim>> positions;
+      positions.reserve(grain_seeds.size());
+      for (const auto &seed : grain_seeds)
+        positions.push_back(seed.position);
+      size_estimate = estimate_adapted_size(geometry,
+                                            band,
+                                            fluid_parameters.enabled,
+                                            positions);
+    }
+    else
+      size_estimate =
+        estimate_size(geometry, fluid_parameters.enabled, grain_seeds.size());
     available_memory = machine_memory(comm);
     if (size_estimate.peak_bytes > 0.9 * available_memory)
     {
       std::ostringstream problem;
       problem << std::setprecision(3) << size_estimate.cells << " cells and "
-              << size_estimate.dofs << " DoFs need about "
-              << size_estimate.peak_bytes / (1 << 30) << " GiB, more than the "
-              << available_memory / (1 << 30)
+              << size_estimate.dofs << " DoFs"
+              << (size_estimate.adapted ? " (the band around the grains)" : "")
+              << " need about " << size_estimate.peak_bytes / (1 << 30)
+              << " GiB, more than the " << available_memory / (1 << 30)
               << " GiB of memory here; lower it or Mesh/Subdivisions ("
               << prm.get({"Mesh"}, "Subdivisions") << ")";
+      if (size_estimate.adapted)
+        InputLocation{file, "Adaptivity"}.fail(
+          "Max level",
+          std::to_string(adaptivity_parameters.max_level),
+          problem.str());
       InputLocation{file, "Mesh"}.fail("Initial refinement",
                                        std::to_string(
                                          geometry.initial_refinement),
@@ -443,7 +473,10 @@ namespace ImmersedGrains
     pcout << "  estimate: " << size_estimate.cells << " cells, "
           << size_estimate.dofs << " DoFs, peak memory about "
           << std::setprecision(3) << size_estimate.peak_bytes / (1 << 30)
-          << " GiB of " << available_memory / (1 << 30) << " GiB\n"
+          << " GiB of " << available_memory / (1 << 30) << " GiB"
+          << (size_estimate.adapted ? " (adapted around the initial grains)" :
+                                      "")
+          << '\n'
           << std::setprecision(6);
 
     if (fluid_parameters.enabled)

@@ -213,6 +213,20 @@ end
              "Initial refinement = 5\nend\n",
          "Initial refinement",
          "5"},
+        // An adaptive mesh of 8^3 cells with grains all through it and
+        // Max level 9: the band around them would hold some 3 million
+        // cells of level 9 (about 500 GB), which the initial 512 cells do
+        // not show; stopped by the adapted estimate, naming Max level.
+        {"adaptive_mesh_too_large",
+         "set Dimension = 3\nsubsection Mesh\n  set Lower corner = 0, 0, 0\n  "
+             "set Upper corner = 1, 1, 1\n  set Subdivisions = 8, 8, 8\nend\n"
+             "subsection Grains\n set Enabled = true\n set Radius = 1e-4\n"
+             " subsection Placement\n  set Shape = box\n  set Center = 0.5, "
+             "0.5, 0.5\n  set Size = 1\n  set Count = 20000\n end\nend\n"
+             "subsection Adaptivity\n set Enabled = true\n set Min level = 0\n"
+             " set Max level = 9\nend\n",
+         "Max level",
+         "9"},
         {"nonpositive_courant_number",
          "set Dimension = 2\nset Adaptive time step = true\nset Courant "
              "number = 0\n",

@@ -239,12 +239,27 @@ namespace ImmersedGrains
 
       // Hash grid of placed grains, cell edge 2 r_max: overlaps can only be
       // with grains in the 3^dim cells around.
+      // At most a few cells per grain: small grains in a large box asked
+      // for 10^9 cells (24 GB of empty lists) when only the edge was
+      // bounded. Larger cells are only slower.
+      const double max_cells = std::max(64., 4. * radii.size());
       std::array<unsigned int, dim> n_cells;
-      unsigned int                  n_total = 1;
+      std::array<double, dim>       wanted;
+      double                        wanted_total = 1;
       for (unsigned int d = 0; d < dim; ++d)
       {
-        n_cells[d] = std::max(
+        wanted[d] = std::max(
           1., std::min(1e3, std::floor((upper[d] - lower[d]) / (2 * r_max))));
+        wanted_total *= wanted[d];
+      }
+      const double shrink  = wanted_total > max_cells ?
+                               std::pow(wanted_total / max_cells, 1. / dim) :
+                               1.;
+      unsigned int n_total = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        n_cells[d] =
+          static_cast<unsigned int>(std::max(1., wanted[d] / shrink));
         n_total *= n_cells[d];
       }
       std::vector<std::vector<unsigned int>> cells(n_total);

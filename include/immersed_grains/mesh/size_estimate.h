@@ -6,6 +6,7 @@
 #include <immersed_grains/mesh/geometry.h>
 
 #include <cstddef>
+#include <vector>
 
 namespace ImmersedGrains
 {
@@ -20,6 +21,9 @@ namespace ImmersedGrains
     double cells      = 0;
     double dofs       = 0; // 0 without a fluid
     double peak_bytes = 0;
+    // Counted on the adaptive mesh around the initial grains (it is
+    // larger than the initial mesh).
+    bool adapted = false;
   };
 
   template <int dim>
@@ -27,6 +31,35 @@ namespace ImmersedGrains
   estimate_size(const Geometry<dim> &geometry,
                 bool                 with_fluid,
                 std::size_t          n_grains);
+
+  /**
+   * What the grain band of an adaptive mesh refines (Adaptivity's
+   * criterion `grains`): every cell below @p min_level, and on each level
+   * from @p min_level up, the cells within @p band_width layers of a cell
+   * that holds a grain, up to @p max_level or to the level whose children
+   * would be smaller than @p smallest_cell.
+   */
+  struct GrainBand
+  {
+    unsigned int min_level     = 0;
+    unsigned int max_level     = 0;
+    unsigned int band_width    = 0;
+    double       smallest_cell = 0;
+  };
+
+  /**
+   * The estimate for an adaptive mesh refined by @p band around the grains
+   * at @p positions (their initial places): the larger of the initial
+   * mesh (Mesh/Initial refinement) and the adapted one. The band's cells
+   * are counted on the level grids without building a mesh, in
+   * O(grains x band) time.
+   */
+  template <int dim>
+  SizeEstimate
+  estimate_adapted_size(const Geometry<dim>                   &geometry,
+                        const GrainBand                       &band,
+                        bool                                   with_fluid,
+                        const std::vector<dealii::Point<dim>> &positions);
 
   /** Physical memory of the machines the ranks of @p comm run on, summed
    * over machines (collective). */
