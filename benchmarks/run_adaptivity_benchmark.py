@@ -10,7 +10,8 @@ writes a PNG of both trajectories (and of the difference) beside the runs.
 
 Usage (after scripts/setup.sh):
     /usr/bin/python3 benchmarks/run_adaptivity_benchmark.py
-        [--scenes cloud_2d_adaptive] [--ranks N] [--out DIR]
+        [--scenes cloud_2d_adaptive cloud_3d_adaptive] [--ranks N]
+        [--out DIR]
 """
 import argparse
 import os
@@ -23,8 +24,11 @@ ROOT = scene_runner.ROOT
 
 def run(prm_text, directory, ranks):
     rows = scene_runner.run_scene(prm_text, directory, ranks)
+    # The vertical axis: y in 2D, z in 3D.
+    vertical = "centroid_z" if re.search(r"set Dimension\s*=\s*3",
+                                         prm_text) else "centroid_y"
     return {"time": [float(r["time"]) for r in rows],
-            "y": [float(r["centroid_y"]) for r in rows],
+            "y": [float(r[vertical]) for r in rows],
             "cells": [int(float(r["cells"])) for r in rows],
             "dofs": [int(float(r["dofs"])) for r in rows],
             "particles": int(float(rows[-1]["particles"])),
