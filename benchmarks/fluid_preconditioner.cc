@@ -17,6 +17,14 @@
 // replaces the ball by the box |x - 0.5|_inf < 0.25, whose faces are mesh
 // faces (no cell is cut by the jump: the diagnosis of doc/benchmarks.md,
 // the drag-jump cells).
+// FLUID_BENCH_GEOMETRY sets the domain the preconditioner's constants were
+// not fitted on (they were fitted on the unit box, `unit`):
+//   column    a tall box 1 x 8 (x 1), the ball at 3/4 of its height;
+//   slab      a thin box 1 x 1/8 in 2D, 1 x 1 x 1/8 in 3D, with the ball
+//             replaced by a cylinder of radius 0.3 through its thickness;
+//   adaptive  the unit box at LEVEL_MIN, refined in a band around the
+//             ball's surface up to LEVEL_MAX (one row per mesh, its finest
+//             level in the level column).
 // benchmarks/run_fluid_benchmarks.sh makes the tables of doc/benchmarks.md.
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
@@ -30,6 +38,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -51,17 +60,7 @@ public:
   double
   value(const Point<dim> &x, unsigned int) const override
   {
-    Point<dim> c;
-    for (unsigned int d = 0; d < dim; ++d)
-      c[d] = 0.5;
-    if (aligned)
-    {
-      for (unsigned int d = 0; d < dim; ++d)
-        if (std::abs(x[d] - 0.5) > 0.25)
-          return outside;
-      return inside;
-    }
-    return x.distance(c) < 0.3 ? inside : outside;
+    return is_inside(x) ? inside : outside;
   }
   Tensor<1, dim>
   gradient(const Point<dim> &, unsigned int) const override
@@ -69,10 +68,69 @@ public:
     return Tensor<1, dim>();
   }
 
+  // The region of low fluid fraction: a ball of radius 0.3 around (0.5,
+  // 0.5, 0.5) in the unit box, (0.5, 6, 0.5) in the column; in the slab a
+  // cylinder through the thin direction (the last one).
+  static bool
+  is_inside(const Point<dim> &x)
+  {
+    const std::string geometry = bench_geometry();
+    Point<dim>        c;
+    for (unsigned int d = 0; d < dim; ++d)
+      c[d] = 0.5;
+    if (geometry == "column")
+      c[1] = 6;
+    if (std::getenv("FLUID_BENCH_ALIGNED") != nullptr)
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        if (std::abs(x[d] - c[d]) > 0.25)
+          return false;
+      return true;
+    }
+    double r2 = 0;
+    for (unsigned int d = 0; d < (geometry == "slab" ? dim - 1 : dim); ++d)
+      r2 += (x[d] - c[d]) * (x[d] - c[d]);
+    return r2 < 0.09;
+  }
+
+  static std::string
+  bench_geometry()
+  {
+    const char *text = std::getenv("FLUID_BENCH_GEOMETRY");
+    return text == nullptr ? "unit" : text;
+  }
+
 private:
-  double     inside, outside;
-  const bool aligned = std::getenv("FLUID_BENCH_ALIGNED") != nullptr;
+  double inside, outside;
 };
+
+// Refines the cells within 1.5 of their own diameters of the ball's surface
+// (the jump) until the finest ones have @p finest levels; the rest keep
+// their level, with the 2:1 balance p4est enforces.
+template <int dim>
+void
+refine_around_jump(parallel::distributed::Triangulation<dim> &tria,
+                   const unsigned int                         finest)
+{
+  Point<dim> c;
+  for (unsigned int d = 0; d < dim; ++d)
+    c[d] = 0.5;
+  for (unsigned int pass = 0; pass < finest; ++pass)
+  {
+    bool marked = false;
+    for (const auto &cell : tria.active_cell_iterators())
+      if (cell->is_locally_owned() &&
+          cell->level() < static_cast<int>(finest) &&
+          std::abs(cell->center().distance(c) - 0.3) < 1.5 * cell->diameter())
+      {
+        cell->set_refine_flag();
+        marked = true;
+      }
+    if (!Utilities::MPI::logical_or(marked, tria.get_communicator()))
+      break;
+    tria.execute_coarsening_and_refinement();
+  }
+}
 
 // A swirling body force that makes flow through and around the porous ball.
 template <int dim>
@@ -117,6 +175,38 @@ peak_memory_mib()
   return stats.VmHWM / 1024.0;
 }
 
+// The Mesh subsection of FLUID_BENCH_GEOMETRY, with cubic cells.
+template <int dim>
+std::string
+mesh_entries()
+{
+  const std::string geometry = JumpField<dim>::bench_geometry();
+  std::string       upper = "1, 1", subdivisions = "1, 1";
+  if (geometry == "column")
+  {
+    upper        = dim == 2 ? "1, 8" : "1, 8, 1";
+    subdivisions = dim == 2 ? "1, 8" : "1, 8, 1";
+  }
+  else if (geometry == "slab")
+  {
+    upper        = dim == 2 ? "1, 0.125" : "1, 1, 0.125";
+    subdivisions = dim == 2 ? "8, 1" : "8, 8, 1";
+  }
+  else
+  {
+    AssertThrow(geometry == "unit" || geometry == "adaptive",
+                ExcMessage("FLUID_BENCH_GEOMETRY: unit, column, slab or "
+                           "adaptive, not " +
+                           geometry));
+    upper        = dim == 2 ? "1, 1" : "1, 1, 1";
+    subdivisions = dim == 2 ? "1, 1" : "1, 1, 1";
+  }
+  return "subsection Mesh\n set Lower corner = " +
+         std::string(dim == 2 ? "0, 0" : "0, 0, 0") +
+         "\n set Upper corner = " + upper +
+         "\n set Subdivisions = " + subdivisions + "\nend\n";
+}
+
 template <int dim>
 void
 run(const unsigned int level_min,
@@ -145,6 +235,7 @@ run(const unsigned int level_min,
         ParameterHandler prm;
         Simulation<dim>::declare_parameters(prm);
         prm.parse_input_from_string(
+          mesh_entries<dim>() +
           std::string(
             "subsection Fluid\n set Density = 1000\n set Viscosity = 1\n") +
           " set Advection = " + (advection ? "true" : "false") +
@@ -160,11 +251,18 @@ run(const unsigned int level_min,
           "\n" + extra_entries + " end\nend\n");
         Geometry<dim> geometry;
         geometry.parse_parameters(prm, "benchmark");
-        geometry.initial_refinement = level;
+        const bool adaptive = JumpField<dim>::bench_geometry() == "adaptive";
+        geometry.initial_refinement = adaptive ? level_min : level;
         FluidParameters<dim> parameters;
         parameters.parse_parameters(prm, "benchmark", geometry);
 
-        const double h = 1.0 / (1 << level);
+        // The finest cell: the shortest side over its subdivisions.
+        double h = std::numeric_limits<double>::max();
+        for (unsigned int d = 0; d < dim; ++d)
+          h = std::min(h,
+                       (geometry.upper_corner[d] - geometry.lower_corner[d]) /
+                         geometry.subdivisions[d]);
+        h /= (1 << level);
         // FLUID_BENCH_BETA_FIXED=1: the listed values are beta L^2/mu with
         // L = 1 the box, the same physical drag on every level, instead of
         // beta h^2/mu, which grows beta fourfold per level.
@@ -180,6 +278,8 @@ run(const unsigned int level_min,
         TimerOutput timer(pcout, TimerOutput::never, TimerOutput::wall_times);
         parallel::distributed::Triangulation<dim> tria(MPI_COMM_WORLD);
         geometry.create_mesh(tria);
+        if (adaptive)
+          refine_around_jump(tria, level);
         FluidSolver<dim> fluid(parameters, geometry, tria, timer, pcout);
         fluid.set_mixture_fields(fields);
         fluid.set_forcing(std::make_shared<Swirl<dim>>());

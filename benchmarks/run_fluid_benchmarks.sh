@@ -29,6 +29,19 @@ fi
 if [ "${LARGE:-0}" = 1 ]; then
   FLUID_BENCH_DT=1,steady,1e-4 $bin 3 5 5 > "$out/preconditioner_3d_level5.md"
 fi
+# GEOMETRY=1: the domains the constants were not fitted on (doc/adaptivity.md,
+# "The fluid preconditioner on adaptive meshes"): an adaptive mesh around the
+# ball (levels 2-6 in 2D, 1-4 in 3D), a column 1 x 8 and a slab 8 x 1/8.
+if [ "${GEOMETRY:-0}" = 1 ]; then
+  export FLUID_BENCH_DT=1,steady FLUID_BENCH_BETA=0,1e4,1e8
+  FLUID_BENCH_GEOMETRY=adaptive $bin 2 2 6 > "$out/preconditioner_2d_adaptive.md"
+  FLUID_BENCH_GEOMETRY=adaptive $bin 3 1 4 > "$out/preconditioner_3d_adaptive.md"
+  FLUID_BENCH_GEOMETRY=column $bin 2 3 5 > "$out/preconditioner_2d_column.md"
+  FLUID_BENCH_GEOMETRY=slab $bin 2 3 5 > "$out/preconditioner_2d_slab.md"
+  FLUID_BENCH_GEOMETRY=column $bin 3 1 2 > "$out/preconditioner_3d_column.md"
+  FLUID_BENCH_GEOMETRY=slab $bin 3 1 2 > "$out/preconditioner_3d_slab.md"
+  unset FLUID_BENCH_DT FLUID_BENCH_BETA
+fi
 # INNER=1: the drag-jump columns with the inner GMRES on the velocity block
 # (doc/benchmarks.md, "The drag-jump cells").
 if [ "${INNER:-0}" = 1 ]; then

@@ -159,6 +159,14 @@ namespace ImmersedGrains
         marked[index[0]] = 1;
       }
 
+    const auto is_marked = [&marked](const auto &other)
+    {
+      if (other->is_artificial())
+        return false;
+      std::vector<dealii::types::global_dof_index> o(1);
+      other->get_dof_indices(o);
+      return marked[o[0]] != 0;
+    };
     const auto vertex_cells = dealii::GridTools::vertex_to_cell_map(
       static_cast<const dealii::Triangulation<dim> &>(triangulation));
     // One layer beyond the band: cells there are kept, not coarsened, or
@@ -193,6 +201,22 @@ namespace ImmersedGrains
             }
           if (near)
             break;
+        }
+        // Across a periodic face the cells share no vertex: the band
+        // continues through the face neighbours there (those across an
+        // edge or a corner of the periodic face are not counted).
+        for (const unsigned int f : cell->face_indices())
+        {
+          if (near || !cell->has_periodic_neighbor(f))
+            continue;
+          const auto neighbor = cell->periodic_neighbor(f);
+          if (!neighbor->has_children())
+            near = is_marked(neighbor);
+          else
+            for (unsigned int c = 0;
+                 c < dealii::GeometryInfo<dim>::max_children_per_face && !near;
+                 ++c)
+              near = is_marked(cell->periodic_neighbor_child_on_subface(f, c));
         }
         if (near)
           grow.push_back(index[0]);

@@ -172,6 +172,8 @@ namespace ImmersedGrains
           {
             auto shifted = c;
             shifted[d] += o;
+            if (geometry.is_periodic(d)) // the band crosses the face
+              shifted[d] = (shifted[d] + n[d]) % n[d];
             if (shifted[d] >= 0 && shifted[d] < n[d])
               grown.push_back(key(shifted));
           }
