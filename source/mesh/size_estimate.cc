@@ -122,7 +122,10 @@ namespace ImmersedGrains
     std::vector<std::uint64_t> refined;      // else: these
     for (unsigned int d = 0; d < dim; ++d)
       cells *= geometry.subdivisions[d];
-    for (unsigned int level = 0; level < finest; ++level)
+    // Below Min level every cell is refined, whatever the floor.
+    const unsigned int top =
+      std::max(finest, std::min(band.min_level, band.max_level));
+    for (unsigned int level = 0; level < top; ++level)
     {
       std::array<std::int64_t, dim> n;
       double                        level_cells = 1;
@@ -131,9 +134,19 @@ namespace ImmersedGrains
         n[d] = static_cast<std::int64_t>(geometry.subdivisions[d]) << level;
         level_cells *= n[d];
       }
-      AssertThrow(*std::max_element(n.begin(), n.end()) < (1 << 21),
-                  dealii::ExcMessage("estimate_adapted_size: more than two "
-                                     "million cells along an edge"));
+      // Beyond the keys' range the band alone is far beyond any memory:
+      // say so through the estimate, which the caller turns into an error
+      // naming Max level.
+      if (*std::max_element(n.begin(), n.end()) >= (1 << 21))
+      {
+        SizeEstimate huge =
+          size_of<dim>(level_cells,
+                       level_cells * initial.dofs / initial.cells,
+                       with_fluid,
+                       positions.size());
+        huge.adapted = true;
+        return huge;
+      }
       if (level < band.min_level)
       {
         cells += ((1 << dim) - 1) * level_cells;
