@@ -19,6 +19,8 @@
 // newest sets, steps 3 and 4); with an interval of 1e6 s it saves none.
 #include <sys/wait.h>
 
+#include "adaptive_cloud_scene.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,47 +39,6 @@ namespace fs = std::filesystem;
 
 namespace
 {
-  const char *scene = R"(set Dimension = 2
-set Time step = 0.05
-subsection Mesh
-  set Lower corner = 0, 0
-  set Upper corner = 2e-3, 2e-3
-  set Subdivisions = 1, 1
-  set Initial refinement = 4
-end
-subsection Fluid
-  set Density   = 1200
-  set Viscosity = 0.12
-  set Advection = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 12.5e-6
-  set Density = 2400
-  subsection Placement
-    set Shape          = ball
-    set Center         = 1e-3, 1.3e-3
-    set Size           = 2.5e-4
-    set Solid fraction = 0.2
-    set Random seed    = 7
-  end
-end
-subsection Coupling
-  set Smoothing length = 5e-5
-end
-subsection Gravity
-  set Vector = 0, -9.81
-end
-subsection Adaptivity
-  set Enabled     = true
-  set Min level   = 2
-  set Max level   = 4
-  set Every steps = 3
-end
-subsection Output
-  set Terminal output = quiet
-end
-)";
 
   // Writes DIRECTORY.prm and runs the executable on it in a child process
   // (with IMMERSED_GRAINS_KILL_DURING_CHECKPOINT = @p kill_at if not
@@ -91,7 +52,7 @@ end
     const std::string file = directory + ".prm";
     {
       std::ofstream prm(file);
-      prm << scene << "set End time = " << end_time
+      prm << adaptive_cloud_scene << "set End time = " << end_time
           << "\nset Output directory = " << directory
           << "\nsubsection Checkpoint\n"
           << checkpoint << "end\n";

@@ -18,6 +18,8 @@
 #include <immersed_grains/parameters.h>
 #include <immersed_grains/simulation.h>
 
+#include "adaptive_cloud_scene.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -31,50 +33,6 @@ using namespace ImmersedGrains;
 
 namespace
 {
-  const char *scene = R"(set Dimension = 2
-set Time step = 0.05
-subsection Mesh
-  set Lower corner = 0, 0
-  set Upper corner = 2e-3, 2e-3
-  set Subdivisions = 1, 1
-  set Initial refinement = 4
-end
-subsection Fluid
-  set Density   = 1200
-  set Viscosity = 0.12
-  set Advection = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 12.5e-6
-  set Density = 2400
-  subsection Placement
-    set Shape          = ball
-    set Center         = 1e-3, 1.3e-3
-    set Size           = 2.5e-4
-    set Solid fraction = 0.2
-    set Random seed    = 7
-  end
-end
-subsection Coupling
-  set Smoothing length = 5e-5
-end
-subsection Gravity
-  set Vector = 0, -9.81
-end
-subsection Adaptivity
-  set Enabled     = true
-  set Min level   = 2
-  set Max level   = 4
-  set Every steps = 3
-end
-subsection Checkpoint
-  set Every steps = 2
-end
-subsection Output
-  set Terminal output = quiet
-end
-)";
 
   void
   run(const std::string &directory,
@@ -86,9 +44,9 @@ end
     if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
     {
       std::ofstream prm(file);
-      prm << scene << "set End time = " << end_time
+      prm << adaptive_cloud_scene << "set End time = " << end_time
           << "\nset Output directory = " << directory
-          << "\nsubsection Checkpoint\n  set Resume = "
+          << "\nsubsection Checkpoint\n  set Every steps = 2\n  set Resume = "
           << (resume ? "true" : "false") << "\nend\n";
     }
     MPI_Barrier(MPI_COMM_WORLD);

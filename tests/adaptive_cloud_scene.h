@@ -1,0 +1,52 @@
+// The scene of the checkpoint tests (checkpoint_restart_2d,
+// checkpoint_killed_2d): 81 discs (r = 12.5 um, 2400 kg/m^3) in a ball of
+// 0.25 mm in glycerine, a 2 mm box, an adaptive mesh (levels 2-4, adapted
+// every 3 steps) and contacts: every kind of state a checkpoint holds.
+// Each test adds End time, the output directory and its Checkpoint
+// subsection.
+#ifndef immersed_grains_tests_adaptive_cloud_scene_h
+#define immersed_grains_tests_adaptive_cloud_scene_h
+
+inline const char *adaptive_cloud_scene = R"(set Dimension = 2
+set Time step = 0.05
+subsection Mesh
+  set Lower corner = 0, 0
+  set Upper corner = 2e-3, 2e-3
+  set Subdivisions = 1, 1
+  set Initial refinement = 4
+end
+subsection Fluid
+  set Density   = 1200
+  set Viscosity = 0.12
+  set Advection = false
+end
+subsection Grains
+  set Enabled = true
+  set Radius  = 12.5e-6
+  set Density = 2400
+  subsection Placement
+    set Shape          = ball
+    set Center         = 1e-3, 1.3e-3
+    set Size           = 2.5e-4
+    set Solid fraction = 0.2
+    set Random seed    = 7
+  end
+end
+subsection Coupling
+  set Smoothing length = 5e-5
+end
+subsection Gravity
+  set Vector = 0, -9.81
+end
+subsection Adaptivity
+  set Enabled     = true
+  set Min level   = 2
+  set Max level   = 4
+  set Every steps = 3
+end
+subsection Output
+  set Terminal output = quiet
+end
+)";
+
+#endif
