@@ -19,7 +19,7 @@
 // newest sets, steps 3 and 4); with an interval of 1e6 s it saves none.
 #include <sys/wait.h>
 
-#include "adaptive_cloud_scene.h"
+#include "checkpoint_test_support.h"
 
 #include <unistd.h>
 
@@ -80,23 +80,6 @@ namespace
     return status;
   }
 
-  std::vector<std::vector<std::string>>
-  read_rows(const std::string &file)
-  {
-    std::vector<std::vector<std::string>> rows;
-    std::ifstream                         in(file);
-    std::string                           line;
-    while (std::getline(in, line))
-    {
-      std::vector<std::string> fields;
-      std::istringstream       split(line);
-      std::string              field;
-      while (std::getline(split, field, ','))
-        fields.push_back(field);
-      rows.push_back(fields);
-    }
-    return rows;
-  }
 
   std::string
   checkpoint_sets(const std::string &directory)
@@ -137,12 +120,12 @@ main()
             << describe(run("killed", 0.5, every_two, "6")) << '\n';
   std::cout << "  checkpoints left:" << checkpoint_sets("killed") << '\n';
   std::cout << "  statistics rows left: "
-            << read_rows("killed/statistics.csv").size() - 1 << '\n';
+            << read_csv_rows("killed/statistics.csv").size() - 1 << '\n';
   std::cout << "the same command again: "
             << describe(run("killed", 0.5, every_two)) << '\n';
 
-  const auto        straight = read_rows("straight/statistics.csv");
-  const auto        resumed  = read_rows("killed/statistics.csv");
+  const auto        straight = read_csv_rows("straight/statistics.csv");
+  const auto        resumed  = read_csv_rows("killed/statistics.csv");
   std::ifstream     log("killed/log.txt");
   const std::string text((std::istreambuf_iterator<char>(log)),
                          std::istreambuf_iterator<char>());

@@ -18,7 +18,7 @@
 #include <immersed_grains/parameters.h>
 #include <immersed_grains/simulation.h>
 
-#include "adaptive_cloud_scene.h"
+#include "checkpoint_test_support.h"
 
 #include <cmath>
 #include <filesystem>
@@ -59,23 +59,6 @@ namespace
     simulation.run();
   }
 
-  std::vector<std::vector<std::string>>
-  read_rows(const std::string &file)
-  {
-    std::vector<std::vector<std::string>> rows;
-    std::ifstream                         in(file);
-    std::string                           line;
-    while (std::getline(in, line))
-    {
-      std::vector<std::string> fields;
-      std::istringstream       split(line);
-      std::string              field;
-      while (std::getline(split, field, ','))
-        fields.push_back(field);
-      rows.push_back(fields);
-    }
-    return rows;
-  }
 } // namespace
 
 
@@ -111,8 +94,8 @@ main(int argc, char **argv)
 
   if (!root)
     return 0;
-  const auto straight = read_rows("straight/statistics.csv");
-  const auto resumed  = read_rows("resumed/statistics.csv");
+  const auto straight = read_csv_rows("straight/statistics.csv");
+  const auto resumed  = read_csv_rows("resumed/statistics.csv");
   std::cout << "rows: straight " << straight.size() - 1 << ", resumed "
             << resumed.size() - 1 << '\n';
   double       largest = 0;
@@ -155,7 +138,7 @@ main(int argc, char **argv)
     // One rank and two round differently (the contact sweeps are split
     // between the ranks), so this run is compared by its figures: every
     // grain kept and the cloud where the straight run has it.
-    const auto   regrouped = read_rows("regrouped/statistics.csv");
+    const auto   regrouped = read_csv_rows("regrouped/statistics.csv");
     unsigned int particles = 0, centroid = 0;
     for (unsigned int c = 0; c < straight[0].size(); ++c)
     {

@@ -1,11 +1,16 @@
-// The scene of the checkpoint tests (checkpoint_restart_2d,
-// checkpoint_killed_2d): 81 discs (r = 12.5 um, 2400 kg/m^3) in a ball of
+// What the checkpoint tests (checkpoint_restart_2d, checkpoint_killed_2d)
+// share. Their scene: 81 discs (r = 12.5 um, 2400 kg/m^3) in a ball of
 // 0.25 mm in glycerine, a 2 mm box, an adaptive mesh (levels 2-4, adapted
 // every 3 steps) and contacts: every kind of state a checkpoint holds.
 // Each test adds End time, the output directory and its Checkpoint
 // subsection.
-#ifndef immersed_grains_tests_adaptive_cloud_scene_h
-#define immersed_grains_tests_adaptive_cloud_scene_h
+#ifndef immersed_grains_tests_checkpoint_test_support_h
+#define immersed_grains_tests_checkpoint_test_support_h
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 inline const char *adaptive_cloud_scene = R"(set Dimension = 2
 set Time step = 0.05
@@ -48,5 +53,24 @@ subsection Output
   set Terminal output = quiet
 end
 )";
+
+// The fields of every line of a CSV file (statistics.csv), header first.
+inline std::vector<std::vector<std::string>>
+read_csv_rows(const std::string &file)
+{
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream                         in(file);
+  std::string                           line;
+  while (std::getline(in, line))
+  {
+    std::vector<std::string> fields;
+    std::istringstream       split(line);
+    std::string              field;
+    while (std::getline(split, field, ','))
+      fields.push_back(field);
+    rows.push_back(fields);
+  }
+  return rows;
+}
 
 #endif
