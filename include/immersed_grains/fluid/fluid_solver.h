@@ -270,7 +270,8 @@ namespace ImmersedGrains
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
     // Whether any drag is present; without it and without inertia (steady
-    // Stokes) the Laplacian term of the Schur approximation is left out.
+    // Stokes) the Laplacian term of the Schur approximation is left out,
+    // except in elongated boxes (build_preconditioner()).
     bool schur_has_drag = false;
     // The velocity block's viscous number in the last assembly of the
     // preconditioner matrices (fluid_assembly.cc), and whether the last
