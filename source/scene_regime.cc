@@ -41,11 +41,7 @@ namespace ImmersedGrains
     const unsigned int levels = adaptivity_parameters.enabled ?
                                   adaptivity_parameters.max_level :
                                   geometry.initial_refinement;
-    double             h      = std::numeric_limits<double>::max();
-    for (unsigned int d = 0; d < dim; ++d)
-      h = std::min(h,
-                   (geometry.upper_corner[d] - geometry.lower_corner[d]) /
-                     geometry.subdivisions[d] / std::pow(2.0, levels));
+    const double       h      = geometry.shortest_cell_edge(levels);
     line("finest cell", number(h) + " m", "");
 
     const bool   with_fluid  = fluid_parameters.enabled;

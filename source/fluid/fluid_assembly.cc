@@ -201,10 +201,7 @@ namespace ImmersedGrains
     dealii::FullMatrix<double> cell_mass(dofs_per_cell, dofs_per_cell);
     dealii::Vector<double>     cell_rhs(dofs_per_cell);
     dealii::Vector<double>     cell_reaction(dofs_per_cell);
-    double                     box_size = std::numeric_limits<double>::max();
-    for (unsigned int d = 0; d < dim; ++d)
-      box_size =
-        std::min(box_size, geometry.upper_corner[d] - geometry.lower_corner[d]);
+    const double               box_size = geometry.shortest_side();
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
     std::vector<PointDrag<dim>>                  drags;
     std::vector<double>                          point_shape(dofs_per_cell);

@@ -11,7 +11,6 @@
 #include <immersed_grains/fluid/fluid_solver.h>
 
 #include <cmath>
-#include <limits>
 
 #include <cstdlib>
 #include <sstream>
@@ -104,15 +103,9 @@ namespace ImmersedGrains
     // catches them: a 1 x 8 column 38-46 -> 27-32 outer iterations, a
     // 1 x 1/8 slab 22-33 -> 16-31 (2D and 3D, levels 1-5; doc/adaptivity.md).
     // In a cube it only adds error (2D level 6: 21 -> 30), hence the gate.
-    double longest = 0, shortest = std::numeric_limits<double>::max();
-    for (unsigned int d = 0; d < dim; ++d)
-    {
-      const double side = geometry.upper_corner[d] - geometry.lower_corner[d];
-      longest           = std::max(longest, side);
-      shortest          = std::min(shortest, side);
-    }
     const bool long_modes =
-      !parameters.time_derivative && !schur_has_drag && longest >= 2 * shortest;
+      !parameters.time_derivative && !schur_has_drag &&
+      geometry.longest_side() >= 2 * geometry.shortest_side();
     const bool mass_term =
       parameters.schur_approximation != SchurApproximation::pressure_laplace;
     const bool laplace_term =

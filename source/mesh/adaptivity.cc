@@ -159,13 +159,18 @@ namespace ImmersedGrains
         marked[index[0]] = 1;
       }
 
-    const auto is_marked = [&marked](const auto &other)
+    // Whether a cell (of the triangulation or of `cells`) is in the band.
+    std::vector<dealii::types::global_dof_index> other_index(1);
+    const auto is_marked = [&](const auto &other)
     {
       if (other->is_artificial())
         return false;
-      std::vector<dealii::types::global_dof_index> o(1);
-      other->get_dof_indices(o);
-      return marked[o[0]] != 0;
+      typename dealii::DoFHandler<dim>::active_cell_iterator(&triangulation,
+                                                             other->level(),
+                                                             other->index(),
+                                                             &cells)
+        ->get_dof_indices(other_index);
+      return marked[other_index[0]] != 0;
     };
     const auto vertex_cells = dealii::GridTools::vertex_to_cell_map(
       static_cast<const dealii::Triangulation<dim> &>(triangulation));
@@ -184,24 +189,10 @@ namespace ImmersedGrains
         if (marked[index[0]] != 0)
           continue;
         bool near = false;
-        for (const unsigned int v : cell->vertex_indices())
-        {
+        for (unsigned int v = 0; v < cell->n_vertices() && !near; ++v)
           for (const auto &other : vertex_cells[cell->vertex_index(v)])
-            if (!other->is_artificial())
-            {
-              std::vector<dealii::types::global_dof_index> o(1);
-              typename dealii::DoFHandler<dim>::active_cell_iterator(
-                &triangulation, other->level(), other->index(), &cells)
-                ->get_dof_indices(o);
-              if (marked[o[0]] != 0)
-              {
-                near = true;
-                break;
-              }
-            }
-          if (near)
-            break;
-        }
+            if ((near = is_marked(other)))
+              break;
         // Across a periodic face the cells share no vertex: the band
         // continues through the face neighbours there (those across an
         // edge or a corner of the periodic face are not counted).

@@ -4,6 +4,10 @@
 
 #include <immersed_grains/mesh/geometry.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace ImmersedGrains
 {
   std::string
@@ -157,6 +161,41 @@ namespace ImmersedGrains
       if (t == BoundaryType::open)
         return true;
     return false;
+  }
+
+
+  template <int dim>
+  double
+  Geometry<dim>::shortest_side() const
+  {
+    double side = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+      side = std::min(side, upper_corner[d] - lower_corner[d]);
+    return side;
+  }
+
+
+  template <int dim>
+  double
+  Geometry<dim>::longest_side() const
+  {
+    double side = 0;
+    for (unsigned int d = 0; d < dim; ++d)
+      side = std::max(side, upper_corner[d] - lower_corner[d]);
+    return side;
+  }
+
+
+  template <int dim>
+  double
+  Geometry<dim>::shortest_cell_edge(const unsigned int level) const
+  {
+    double h = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+      h = std::min(h,
+                   (upper_corner[d] - lower_corner[d]) / subdivisions[d] /
+                     std::pow(2.0, level));
+    return h;
   }
 
 

@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 
 namespace ImmersedGrains
 {
@@ -83,18 +82,9 @@ namespace ImmersedGrains
     // The levels the band reaches: the cell-size floor (Adaptivity) stops
     // refinement where a cell's shortest edge is below twice the floor.
     unsigned int finest = 0;
-    while (finest < band.max_level)
-    {
-      double shortest = std::numeric_limits<double>::max();
-      for (unsigned int d = 0; d < dim; ++d)
-        shortest =
-          std::min(shortest,
-                   (geometry.upper_corner[d] - geometry.lower_corner[d]) /
-                     (geometry.subdivisions[d] * std::pow(2., finest)));
-      if (shortest < 2 * band.smallest_cell)
-        break;
+    while (finest < band.max_level &&
+           geometry.shortest_cell_edge(finest) >= 2 * band.smallest_cell)
       ++finest;
-    }
 
     // Cells of level l by integer coordinates, packed into one key (21
     // bits per axis: up to two million cells along an edge).

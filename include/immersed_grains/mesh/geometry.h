@@ -56,6 +56,17 @@ namespace ImmersedGrains
     bool
     has_open_boundary() const;
 
+    /** The shortest and the longest side of the box. */
+    double
+    shortest_side() const;
+    double
+    longest_side() const;
+
+    /** The shortest edge of the cells of refinement level @p level (the
+     *  coarse mesh of `Subdivisions` is level 0). */
+    double
+    shortest_cell_edge(unsigned int level) const;
+
     dealii::Point<dim>        lower_corner;
     dealii::Point<dim>        upper_corner;
     std::vector<unsigned int> subdivisions;
