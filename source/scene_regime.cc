@@ -156,7 +156,13 @@ namespace ImmersedGrains
         coupling_parameters.drag_distribution +
         ", self-disturbance correction " +
         on(coupling_parameters.self_correction) + ", grain sub-steps " +
-        on(coupling_parameters.grain_substeps));
+        on(coupling_parameters.grain_substeps) +
+        (dim == 2 ?
+           std::string(", closure porosity ") +
+             (coupling_parameters.projection.closure_porosity.sphere_packing ?
+                "of the sphere packing" :
+                "the area fraction") :
+           std::string()));
     regime.switches.push_back(
       "adaptivity: " + on(adaptivity_parameters.enabled) +
       "; adaptive time step: " + on(adaptive_time_step));
@@ -190,6 +196,24 @@ namespace ImmersedGrains
         " grain radii: below 8 radii a grain feels its own disturbance "
         "(4 % too fast at 8 radii and phi_s = 0.3, more below, "
         "doc/validation.md); use at least 8 radii");
+    // A packed 2D bed (placed at an area fraction whose fluid fraction lies
+    // below the bound, or on a touching lattice) read by area.
+    const bool by_fraction = (grain_parameters.shape == PlacementShape::ball ||
+                              grain_parameters.shape == PlacementShape::box) &&
+                             grain_parameters.count == 0;
+    const double placed_solid =
+      grain_parameters.shape == PlacementShape::lattice ?
+        std::acos(-1.0) / 4 :
+        (by_fraction ? grain_parameters.solid_fraction : 0.0);
+    if (two_way && dim == 2 &&
+        !coupling_parameters.projection.closure_porosity.sphere_packing &&
+        1 - placed_solid < coupling_parameters.projection.min_fluid_fraction)
+      regime.warnings.push_back(
+        "grains placed at area fraction " + number(placed_solid, 2) +
+        " with Closure porosity in 2D = area fraction: the drag law and the "
+        "fluid see the bound 1 - Minimum fluid fraction instead of the "
+        "packing (doc/theory.md, \"Dense 2D beds\"); use Closure porosity "
+        "in 2D = sphere packing for a packed 2D bed");
     if (coupled && h < d && l < d)
       regime.warnings.push_back(
         "cells of " + number(h / d, 2) +

@@ -547,6 +547,9 @@ namespace ImmersedGrains
             << (coupling_parameters.tracers ?
                   ", tracers" :
                   (coupling_parameters.two_way ? ", two-way" : ", one-way"))
+            << (coupling_parameters.projection.closure_porosity.sphere_packing ?
+                  ", porosity of the equivalent sphere packing" :
+                  "")
             << '\n';
     }
     if (cloud_analysis)
@@ -1004,10 +1007,17 @@ namespace ImmersedGrains
       const unsigned int clamped = coupling->solid_fraction().n_clamped();
       statistics.set("clamped_fluid_fraction_nodes", clamped);
       if (clamped > 0 && clamped_nodes_before == 0)
+      {
         pcout << "  warning: step " << step << ": the grains pack beyond "
-              << "1 - Coupling/Minimum fluid fraction at " << clamped
-              << " solid-fraction node(s); the fluid sees the minimum "
-              << "there (column clamped_fluid_fraction_nodes)\n";
+              << "the bound of Coupling/Minimum fluid fraction at " << clamped
+              << " solid-fraction node(s); the fluid sees the bound there "
+              << "(column clamped_fluid_fraction_nodes)\n";
+        if (dim == 2 &&
+            !coupling_parameters.projection.closure_porosity.sphere_packing)
+          pcout << "  (discs pack to area fractions up to 0.91: for a "
+                << "packed 2D bed set Coupling/Closure porosity in 2D = "
+                << "sphere packing, doc/theory.md)\n";
+      }
       clamped_nodes_before = clamped;
     }
     // (Collective: decided by the layout, which every rank shares, not by

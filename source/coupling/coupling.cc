@@ -187,6 +187,17 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  typename FilteredDrag<dim>::SolidScale
+  Coupling<dim>::solid_scale() const
+  {
+    if (projection->n_clamped() == 0)
+      return {};
+    return [this](const auto &cell, const auto &reference_points)
+    { return projection->solid_scale(cell, reference_points); };
+  }
+
+
+  template <int dim>
   void
   Coupling<dim>::evaluate(
     const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
@@ -196,8 +207,20 @@ namespace ImmersedGrains
     MixtureValues<dim>                    &values) const
   {
     projection->evaluate(cell, points, reference_points, time, values);
-    if (filtered_drag)
-      filtered_drag->evaluate(cell, reference_points, values);
+    if (!filtered_drag)
+      return;
+    filtered_drag->evaluate(cell, reference_points, values);
+    if (parameters.two_way && parameters.implicit_coupling)
+      // Where the fluid fraction is clamped, the grains fill only the rest:
+      // their flux s + alpha u - k (s_scale grad p) and their share of the
+      // pressure gradient, scaled like the explicit flux.
+      for (unsigned int q = 0; q < reference_points.size(); ++q)
+      {
+        const double scale = values.solid_scale[q];
+        values.solid_flux[q] *= scale;
+        values.pressure_gradient_weight[q] *= scale;
+        values.pressure_mobility[q] *= scale * scale;
+      }
   }
 
 
@@ -295,7 +318,7 @@ namespace ImmersedGrains
     return {radius,
             grain_projected_area<dim>(radius),
             grain_volume<dim>(radius),
-            fluid_fraction,
+            parameters.projection.closure_porosity.of(fluid_fraction),
             slip.norm(),
             density,
             viscosity};
@@ -401,6 +424,9 @@ namespace ImmersedGrains
                                            velocities_of(fluid_values);
         const std::vector<double> felt_fraction =
           projection->felt_fluid_fraction(cell, references);
+        const std::vector<double> scale =
+          implicit_velocity ? std::vector<double>() :
+                              projection->solid_scale(cell, references);
         for (unsigned int i = first; i < end; ++i)
         {
           const unsigned int k = i - first;
@@ -410,7 +436,8 @@ namespace ImmersedGrains
           // buoyancy (m g comes from Grains) and the dynamic pressure.
           lagged_force[i] = -density * V * g;
           if (!implicit_velocity)
-            lagged_force[i] -= V * fluid_values[k].pressure_gradient;
+            lagged_force[i] -= (scale.empty() ? 1.0 : scale[k]) * V *
+                               fluid_values[k].pressure_gradient;
           DragInput in =
             drag_input(r, felt_fraction[k], c.velocity[i] - felt[k]);
           gamma[i]               = drag_law->coefficient(in);
@@ -530,7 +557,8 @@ namespace ImmersedGrains
     if (drag_as_field() && as_predicted)
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
                                      fluid.get_solution(),
-                                     implicit_velocity);
+                                     implicit_velocity,
+                                     solid_scale());
     filtered_velocity_current = true;
     if (!as_predicted)
     {
@@ -558,12 +586,17 @@ namespace ImmersedGrains
               filtered_drag->filtered_pressure_gradient(cell, references);
         }
         if (!drag_as_field() || (!implicit_velocity && !as_predicted))
+        {
           for (const auto &v : fluid.point_values(cell, references))
           {
             if (!drag_as_field())
               felt.push_back(v.velocity);
             pressure_gradient.push_back(v.pressure_gradient);
           }
+          const auto scale = projection->solid_scale(cell, references);
+          for (unsigned int k = 0; k < scale.size(); ++k)
+            pressure_gradient[k] *= scale[k];
+        }
         const std::vector<double> felt_fraction =
           as_predicted ? std::vector<double>() :
                          projection->felt_fluid_fraction(cell, references);
@@ -643,7 +676,8 @@ namespace ImmersedGrains
       return {on_fluid, on_grains};
     if (filtered_drag)
       on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
-                                               fluid.get_solution());
+                                               fluid.get_solution(),
+                                               solid_scale());
     if (!drag_as_field())
     {
       // The point drags through the fluid velocity the grains felt.

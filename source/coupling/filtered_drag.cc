@@ -5,6 +5,24 @@
 
 namespace ImmersedGrains
 {
+  namespace
+  {
+    // The solid scale at the quadrature points of @p fe_values' cell; empty
+    // where it is 1 everywhere.
+    template <int dim>
+    std::vector<double>
+    scale_at(const typename FilteredDrag<dim>::SolidScale &solid_scale,
+             const dealii::FEValues<dim>                  &fe_values)
+    {
+      if (!solid_scale)
+        return {};
+      const typename dealii::Triangulation<dim>::active_cell_iterator cell(
+        fe_values.get_cell());
+      return solid_scale(cell, fe_values.get_quadrature().get_points());
+    }
+  } // namespace
+
+
   template <int dim>
   FilteredDrag<dim>::FilteredDrag(
     const dealii::parallel::distributed::Triangulation<dim> &tria,
@@ -220,7 +238,8 @@ namespace ImmersedGrains
   FilteredDrag<dim>::filter_velocity(
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
     const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
-    const bool                                        with_pressure_gradient)
+    const bool                                        with_pressure_gradient,
+    const SolidScale                                 &solid_scale)
   {
     const dealii::FEValuesExtractors::Vector velocities(0);
     const dealii::FEValuesExtractors::Scalar pressure(dim);
@@ -235,7 +254,12 @@ namespace ImmersedGrains
         fluid_dof_handler,
         [&](const dealii::FEValues<dim>         &fe_values,
             std::vector<dealii::Tensor<1, dim>> &values)
-        { fe_values[pressure].get_function_gradients(fluid_solution, values); },
+        {
+          fe_values[pressure].get_function_gradients(fluid_solution, values);
+          const auto scale = scale_at(solid_scale, fe_values);
+          for (unsigned int q = 0; q < scale.size(); ++q)
+            values[q] *= scale[q];
+        },
         pressure_gradient);
   }
 
@@ -352,7 +376,8 @@ namespace ImmersedGrains
   dealii::Tensor<1, dim>
   FilteredDrag<dim>::force_on_fluid(
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
-    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution) const
+    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+    const SolidScale                                 &solid_scale) const
   {
     const dealii::FEValuesExtractors::Vector velocities(0);
     const dealii::FEValuesExtractors::Scalar pressure(dim);
@@ -371,8 +396,10 @@ namespace ImmersedGrains
         a.resize(n_q);
         fluid_values[pressure].get_function_gradients(fluid_solution, grad_p);
         filter_values.get_function_values(alpha, a);
+        const auto scale = scale_at(solid_scale, fluid_values);
         for (unsigned int q = 0; q < n_q; ++q)
-          force -= a[q] * grad_p[q] * fluid_values.JxW(q);
+          force -= (scale.empty() ? 1.0 : scale[q]) * a[q] * grad_p[q] *
+                   fluid_values.JxW(q);
         if (!drag_as_field)
           return;
         u.resize(n_q);

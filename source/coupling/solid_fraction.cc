@@ -25,11 +25,25 @@ namespace ImmersedGrains
                       "phi_s = b that makes the solid fraction independent of "
                       "the mesh once cells are smaller than grains; 0: none. "
                       "A grain diameter or two is typical.");
-    prm.declare_entry("Minimum fluid fraction",
-                      "0.3",
-                      Double(0.01, 1),
-                      "The fluid sees at least this fluid fraction; where the "
-                      "grains pack denser the log warns and phi is clamped.");
+    prm.declare_entry(
+      "Minimum fluid fraction",
+      "0.3",
+      Double(0.01, 1),
+      "The drag closure reads at least this porosity, and the fluid at "
+      "least the fluid fraction that maps onto it (the same number unless "
+      "'Closure porosity in 2D' maps it); where the grains pack denser the "
+      "log warns, phi is clamped and the grains' volume in the mixture is "
+      "scaled to 1 - phi, so that the mixture still fills the space.");
+    prm.declare_entry(
+      "Closure porosity in 2D",
+      "area fraction",
+      Selection("area fraction|sphere packing"),
+      "The porosity the drag law reads in a 2D scene: 'area fraction' the "
+      "fluid's area fraction phi (the seed's choice; dilute clouds); "
+      "'sphere packing' the porosity of the sphere packing with the same "
+      "gap-to-radius ratio, 1 - 0.8574 (1 - phi)^{3/2} (hexagonal onto "
+      "FCC, random close onto random close: dense beds; doc/theory.md). "
+      "Ignored in 3D.");
   }
 
 
@@ -42,6 +56,8 @@ namespace ImmersedGrains
     lumped             = prm.get("Solid fraction projection") == "lumped";
     smoothing_length   = prm.get_double("Smoothing length");
     min_fluid_fraction = prm.get_double("Minimum fluid fraction");
+    closure_porosity.sphere_packing =
+      dim == 2 && prm.get("Closure porosity in 2D") == "sphere packing";
   }
 
 
@@ -158,8 +174,9 @@ namespace ImmersedGrains
     }
 
     unsigned int local_clamped = 0;
+    const double bound         = parameters.fluid_fraction_bound();
     for (const auto i : filter.locally_owned_dofs())
-      if (1 - fraction[i] < parameters.min_fluid_fraction)
+      if (1 - fraction[i] < bound)
         ++local_clamped;
     clamped =
       dealii::Utilities::MPI::sum(local_clamped,
@@ -212,37 +229,78 @@ namespace ImmersedGrains
     };
 
     evaluate_field(fraction);
+    // The fluid fraction is clamped node by node, so that it stays a Q1
+    // field whose gradient the quadrature integrates exactly: clamped point
+    // by point, max(1 - phi_s, bound) has a kink inside the cells at the
+    // edge of a packed region, and the continuity equation
+    // phi div u + grad phi . u, integrated by Gauss points across the kink,
+    // lost up to 60 % of the flux through a packed bed.
+    const std::vector<double> solid = field_values;
+    std::vector<double>       phi_local(n);
+    for (unsigned int i = 0; i < n; ++i)
+      phi_local[i] = clamped_fluid_fraction(local[i]);
     for (unsigned int q = 0; q < n_points; ++q)
     {
-      const double phi = 1 - field_values[q];
-      // Clamped where grains pack beyond the physical range: the gradient
-      // of the clamped field is then zero.
-      if (phi < parameters.min_fluid_fraction)
-      {
-        values.fluid_fraction[q]          = parameters.min_fluid_fraction;
-        values.fluid_fraction_gradient[q] = 0;
-      }
-      else
-      {
-        values.fluid_fraction[q]          = std::min(phi, 1.0);
-        values.fluid_fraction_gradient[q] = -shapes.gradient_of(local, q);
-      }
+      values.fluid_fraction[q]          = shapes.value_of(phi_local, q);
+      values.fluid_fraction_gradient[q] = shapes.gradient_of(phi_local, q);
+      values.solid_scale[q]      = scale(solid[q], values.fluid_fraction[q]);
       values.drag_coefficient[q] = 0;
       values.mass_source[q]      = 0;
     }
-    std::vector<double> solid(n_points);
-    for (unsigned int q = 0; q < n_points; ++q)
-      solid[q] = 1 - values.fluid_fraction[q];
     for (unsigned int d = 0; d < dim; ++d)
     {
       evaluate_field(flux[d]);
       for (unsigned int q = 0; q < n_points; ++q)
       {
-        values.solid_flux[q][d] = field_values[q];
+        values.solid_flux[q][d] = values.solid_scale[q] * field_values[q];
         values.grain_velocity[q][d] =
           solid[q] > 1e-12 ? field_values[q] / solid[q] : 0.0;
       }
     }
+  }
+
+
+  template <int dim>
+  double
+  SolidFraction<dim>::clamped_fluid_fraction(const double solid) const
+  {
+    return std::max(1 - solid, parameters.fluid_fraction_bound());
+  }
+
+
+  template <int dim>
+  double
+  SolidFraction<dim>::scale(const double solid, const double fluid_fraction)
+  {
+    // Only where a clamp from below makes phi + phi_s exceed 1.
+    return solid > 0 ? std::min(1.0, (1 - fluid_fraction) / solid) : 1.0;
+  }
+
+
+  template <int dim>
+  std::vector<double>
+  SolidFraction<dim>::solid_scale(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &tria_cell,
+    const std::vector<dealii::Point<dim>> &reference_points) const
+  {
+    if (clamped == 0)
+      return {};
+    const auto         cell = filter.dof_cell(tria_cell);
+    const unsigned int n    = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::types::global_dof_index> indices(n);
+    cell->get_dof_indices(indices);
+    std::vector<double> local(n), phi_local(n);
+    for (unsigned int i = 0; i < n; ++i)
+    {
+      local[i]     = fraction[indices[i]];
+      phi_local[i] = clamped_fluid_fraction(local[i]);
+    }
+    shapes.reinit(tria_cell, reference_points, false);
+    std::vector<double> result(reference_points.size());
+    for (unsigned int q = 0; q < result.size(); ++q)
+      result[q] =
+        scale(shapes.value_of(local, q), shapes.value_of(phi_local, q));
+    return result;
   }
 
 
@@ -264,7 +322,7 @@ namespace ImmersedGrains
       for (unsigned int i = 0; i < n; ++i)
         phi_s += field[indices[i]] * filter.get_fe().shape_value(i, x);
       result.push_back(
-        std::clamp(1 - phi_s, parameters.min_fluid_fraction, 1.0));
+        std::clamp(1 - phi_s, parameters.fluid_fraction_bound(), 1.0));
     }
     return result;
   }

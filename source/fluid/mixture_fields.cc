@@ -14,6 +14,7 @@ namespace ImmersedGrains
     mass_source.resize(n);
     pressure_gradient_weight.assign(n, 0.0);
     pressure_mobility.assign(n, 0.0);
+    solid_scale.assign(n, 1.0);
   }
 
 

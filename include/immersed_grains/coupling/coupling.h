@@ -192,7 +192,13 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>> &references) const;
 
-    /// What the drag law needs of a grain of @p radius.
+    // SolidFraction::solid_scale() for the filter's loops; empty (1
+    // everywhere, nothing evaluated) when no node is clamped.
+    typename FilteredDrag<dim>::SolidScale
+    solid_scale() const;
+
+    /// What the drag law needs of a grain of @p radius, at the fluid
+    /// fraction @p fluid_fraction (read as Closure porosity in 2D says).
     DragInput
     drag_input(double                        radius,
                double                        fluid_fraction,

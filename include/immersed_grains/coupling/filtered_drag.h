@@ -40,6 +40,14 @@ namespace ImmersedGrains
   class FilteredDrag
   {
   public:
+    /**
+     * The share of the grains' volume the mixture sees at points of a cell
+     * (SolidFraction::solid_scale(); empty: 1 everywhere).
+     */
+    using SolidScale = std::function<std::vector<double>(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &,
+      const std::vector<dealii::Point<dim>> &)>;
+
     FilteredDrag(const dealii::parallel::distributed::Triangulation<dim> &tria,
                  const Geometry<dim> &geometry,
                  double               length,
@@ -57,12 +65,14 @@ namespace ImmersedGrains
              std::vector<PointDrag<dim>> &)> &drags);
 
     /** Filters the velocity (and, if @p with_pressure_gradient, the
-     * pressure gradient) of a Q2^dim-Q1 fluid solution. */
+     * pressure gradient times @p solid_scale, the force per volume on the
+     * grains) of a Q2^dim-Q1 fluid solution. */
     void
     filter_velocity(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
       const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
-      bool with_pressure_gradient = false);
+      bool              with_pressure_gradient = false,
+      const SolidScale &solid_scale            = SolidScale());
 
     /** The filtered velocity at points of a cell. */
     std::vector<dealii::Tensor<1, dim>>
@@ -85,12 +95,14 @@ namespace ImmersedGrains
       MixtureValues<dim>                    &values) const;
 
     /** Minus the integral of beta_h u - m_h (with the drag as a field) and
-     * of alpha_h grad p over the mesh: the force the grains' drag exerts on
-     * the fluid, measured through the fluid's own fields. */
+     * of s alpha_h grad p (s = @p solid_scale) over the mesh: the force the
+     * grains' drag exerts on the fluid, measured through the fluid's own
+     * fields. */
     dealii::Tensor<1, dim>
     force_on_fluid(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
-      const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution) const;
+      const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+      const SolidScale &solid_scale = SolidScale()) const;
 
   private:
     // Values of the Q1 fields @p fields at points of a cell, one vector per

@@ -6,6 +6,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <immersed_grains/coupling/closure_porosity.h>
 #include <immersed_grains/coupling/helmholtz_filter.h>
 #include <immersed_grains/fluid/mixture_fields.h>
 #include <immersed_grains/mesh/cell_point_shapes.h>
@@ -51,9 +52,18 @@ namespace ImmersedGrains
       void
       parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
-      bool   lumped             = false;
-      double smoothing_length   = 0;
-      double min_fluid_fraction = 0.3;
+      /** The least fluid fraction of the field the fluid sees: the one
+       *  the closure reads as Minimum fluid fraction. */
+      double
+      fluid_fraction_bound() const
+      {
+        return closure_porosity.fluid_fraction_of(min_fluid_fraction);
+      }
+
+      bool            lumped             = false;
+      double          smoothing_length   = 0;
+      double          min_fluid_fraction = 0.3; // of the closure's porosity
+      ClosurePorosity closure_porosity;
     };
 
     SolidFraction(
@@ -85,9 +95,25 @@ namespace ImmersedGrains
     n_clamped() const;
 
     /**
-     * MixtureFields: phi = max(1 - phi_s, min), its gradient, the grain
-     * velocity flux/phi_s and div of the flux; no continuous drag (the
-     * grains' drag enters as point terms).
+     * The share of the grains' volume the mixture sees at points of a cell:
+     * (1 - phi) / phi_s where the fluid fraction phi is raised by the clamp
+     * at the bound phi_min (in cells with a clamped node), else 1. Where the
+     * fluid fraction is clamped, the solid flux, the grains' share of the
+     * pressure gradient and the pressure force on the grains are scaled by it,
+     * so that fluid and grains still fill the space (phi + s phi_s = 1) in the
+     * mixture continuity and in the momentum balance. Empty when no node is
+     * clamped (then it is 1 everywhere).
+     */
+    std::vector<double>
+    solid_scale(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &reference_points) const;
+
+    /**
+     * MixtureFields: phi, the Q1 field of max(1 - phi_s, min) at the nodes,
+     * its gradient, the grain
+     * velocity flux/phi_s, the solid flux scaled by solid_scale(); no
+     * continuous drag (the grains' drag enters as point terms).
      */
     void
     evaluate(
@@ -104,7 +130,8 @@ namespace ImmersedGrains
      * singular at the grain in 3D (logarithmically in 2D), so its value
      * at the grain itself would grow without bound as the mesh is refined
      * under a fixed l; filtered twice it is bounded and converges. Clamped
-     * to [Minimum fluid fraction, 1].
+     * to [Parameters::fluid_fraction_bound(), 1]; the drag law reads
+     * Parameters::closure_porosity of it.
      */
     std::vector<double>
     felt_fluid_fraction(
@@ -119,6 +146,18 @@ namespace ImmersedGrains
     solid_fraction() const;
 
   private:
+    // A node's fluid fraction: 1 - @p solid, at least the bound. Not capped
+    // at 1: where a consistent projection undershoots (phi_s < 0 next to a
+    // cloud) the field keeps 1 - phi_s, so that its integral stays the
+    // domain minus the grains' volume.
+    double
+    clamped_fluid_fraction(double solid) const;
+
+    // The solid scale at a point of solid fraction @p solid and (clamped)
+    // fluid fraction @p fluid_fraction.
+    static double
+    scale(double solid, double fluid_fraction);
+
     const Parameters    &parameters;
     HelmholtzFilter<dim> filter;
     // The filter's Q1 shapes at the points last asked for.

@@ -34,6 +34,10 @@ namespace ImmersedGrains
     // fluid by drag), and the solid flux is s + alpha u - k grad p.
     std::vector<double> pressure_gradient_weight; // alpha
     std::vector<double> pressure_mobility;        // k
+    // The share of the grains' volume the mixture sees: below 1 only where
+    // the fluid fraction is clamped (SolidFraction::solid_scale()); the
+    // fields above already include it.
+    std::vector<double> solid_scale;
   };
 
 
