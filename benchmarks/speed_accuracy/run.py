@@ -1,0 +1,181 @@
+#!/usr/bin/python3
+"""Speed against accuracy on the README's main scene (doc/speed-accuracy.md):
+the seed's 2D cloud (prm/falling_cloud_2d.prm) run to t = END under a set
+of strategies, each changing one choice of the scene's defaults, against a
+reference run at the finest setting. Writes a table (markdown) and a PNG
+of error against wall time with the Pareto front.
+
+    benchmarks/speed_accuracy/run.py [--end 0.3] [--only NAME,...] [--out DIR]
+
+Error: the cloud's centroid at END against the reference's, as a
+percentage of the distance the reference fell; and the cloud's horizontal
+extent (radius of gyration) against the reference's, in percent. END is
+before the break-up (0.32 s), whose time is chaotic to a few
+milliseconds (tests/cloud_breakup_2d.prm): the compact cloud's fall and
+its spreading are the figures a strategy should keep.
+"""
+import argparse
+import json
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from scene_runner import ROOT, read_csv, run_scene  # noqa: E402
+
+SCENE = os.path.join(ROOT, "prm", "falling_cloud_2d.prm")
+WORK = os.path.join(ROOT, "benchmarks", "results", "speed_accuracy")
+
+
+def override(section, entry, value):
+    """Parameter text that sets @p entry in @p section ('' for the top
+    level, 'A/B' for nested subsections); later settings win."""
+    if not section:
+        return f"set {entry} = {value}\n"
+    parts = section.split("/")
+    text = "".join(f"subsection {p}\n" for p in parts)
+    text += f"  set {entry} = {value}\n"
+    text += "end\n" * len(parts)
+    return text
+
+
+# name: (what it changes, overrides). The default is the scene as shipped.
+STRATEGIES = {
+    "reference": ("Courant 0.025, Max level 5, tolerance 1e-8",
+                  [("", "Courant number", 0.025),
+                   ("Adaptivity", "Max level", 5),
+                   ("Fluid/Linear solver", "Tolerance", 1e-8)]),
+    "default": ("the scene as shipped (Courant 0.1, Max level 4, BDF2, "
+                "extrapolated advection, tolerance 1e-6)", []),
+    "courant_0.5": ("Courant number 0.5", [("", "Courant number", 0.5)]),
+    "courant_0.25": ("Courant number 0.25", [("", "Courant number", 0.25)]),
+    "courant_0.05": ("Courant number 0.05", [("", "Courant number", 0.05)]),
+    "grains_rule": ("no grain sub-steps: the fluid step follows the grains "
+                    "(r/8 per step)",
+                    [("Coupling", "Grain sub-steps", "false")]),
+    "max_level_3": ("Adaptivity/Max level 3", [("Adaptivity", "Max level", 3)]),
+    "max_level_5": ("Adaptivity/Max level 5", [("Adaptivity", "Max level", 5)]),
+    "uniform_4": ("a uniform mesh at level 4 (no adaptivity)",
+                  [("Adaptivity", "Enabled", "false"),
+                   ("Mesh", "Initial refinement", 4)]),
+    "tolerance_1e-4": ("Fluid/Linear solver/Tolerance 1e-4",
+                       [("Fluid/Linear solver", "Tolerance", 1e-4)]),
+    "tolerance_1e-8": ("Fluid/Linear solver/Tolerance 1e-8",
+                       [("Fluid/Linear solver", "Tolerance", 1e-8)]),
+    "bdf1": ("Fluid/Time scheme BDF1", [("Fluid", "Time scheme", "BDF1")]),
+    "picard": ("Fluid/Linearization Picard (iterated to the nonlinear "
+               "tolerance)", [("Fluid", "Linearization", "Picard")]),
+    "stokes": ("Fluid/Advection false (Stokes)",
+               [("Fluid", "Advection", "false")]),
+    "smoothing_0": ("Coupling/Smoothing length 0 (the scene: 1e-4 m)",
+                    [("Coupling", "Smoothing length", 0)]),
+    "smoothing_2e-4": ("Coupling/Smoothing length 2e-4 m",
+                       [("Coupling", "Smoothing length", 2e-4)]),
+    "filtered": ("Coupling/Drag distribution filtered (l = 1e-4 m)",
+                 [("Coupling", "Drag distribution", "filtered")]),
+}
+
+
+def run(name, end):
+    description, changes = STRATEGIES[name]
+    text = open(SCENE).read()
+    text += override("", "End time", end)
+    text += override("Output", "Write fields every", 0)
+    for section, entry, value in changes:
+        text += override(section, entry, value)
+    directory = os.path.join(WORK, name)
+    start = time.time()
+    rows = run_scene(text, directory)
+    wall = time.time() - start
+    last = rows[-1]
+    timings = read_csv(os.path.join(directory, "timings.csv"))
+    setup = float(timings[0]["total"]) if timings else 0.0
+    return dict(name=name, description=description, wall=wall,
+                run=wall - setup, steps=len(rows) - 1,
+                y0=float(rows[0]["cloud_centroid_y"]),
+                y=float(last["cloud_centroid_y"]),
+                x=float(last["cloud_centroid_x"]),
+                width=float(last["cloud_extent_x"]),
+                time=float(last["time"]))
+
+
+def plot(results, reference, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    points = [(r["run"], max(r["error"], 1e-4), r["name"])
+              for r in results if r["name"] != "reference"]
+    for wall, error, name in points:
+        ax.plot(wall, error, "*" if name == "default" else "o",
+                color="C3" if name == "default" else "C0",
+                markersize=11 if name == "default" else 6)
+        ax.annotate(name, (wall, error), fontsize=7,
+                    xytext=(3, 3), textcoords="offset points")
+    # Pareto front: no other point both faster and more accurate.
+    front = sorted((p for p in points
+                    if not any(q[0] <= p[0] and q[1] < p[1] or
+                               q[0] < p[0] and q[1] <= p[1] for q in points)),
+                   key=lambda p: p[0])
+    ax.plot([p[0] for p in front], [p[1] for p in front], "-", color="C3",
+            label="Pareto front")
+    ax.axvline(reference["run"], color="grey", ls=":",
+               label="reference run (%.0f s)" % reference["run"])
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time after set-up [s], one core")
+    ax.set_ylabel("centroid error [% of the distance fallen]")
+    ax.set_title("2D falling cloud to t = %.2f s: error against cost"
+                 % reference["time"])
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--end", type=float, default=0.3)
+    parser.add_argument("--only", default="")
+    parser.add_argument("--out", default=WORK)
+    parser.add_argument("--plot-only", action="store_true",
+                        help="redraw the table and figure from results.json")
+    args = parser.parse_args()
+    names = args.only.split(",") if args.only else list(STRATEGIES)
+    if "reference" not in names:
+        names = ["reference"] + names
+    os.makedirs(args.out, exist_ok=True)
+    saved = os.path.join(args.out, "results.json")
+    if args.plot_only:
+        results = json.load(open(saved))
+    else:
+        results = []
+        for name in names:
+            results.append(run(name, args.end))
+            print("ran %-16s %6.1f s" % (name, results[-1]["wall"]), flush=True)
+        json.dump(results, open(saved, "w"), indent=1)
+    reference = results[0]
+    fallen = reference["y0"] - reference["y"]
+    lines = ["| strategy | change | fluid steps | wall time after set-up s | "
+             "centroid error, % of the fall | width error % |",
+             "|---|---|---|---|---|---|"]
+    for r in results:
+        dx, dy = r["x"] - reference["x"], r["y"] - reference["y"]
+        r["error"] = 100 * (dx * dx + dy * dy) ** 0.5 / fallen
+        r["width_error"] = 100 * (r["width"] / reference["width"] - 1)
+        lines.append("| %s | %s | %d | %.1f | %s | %s |" % (
+            r["name"], r["description"], r["steps"], r["run"],
+            "—" if r is reference else "%.3f" % r["error"],
+            "—" if r is reference else "%+.2f" % r["width_error"]))
+    lines.append("")
+    lines.append("Reference: the cloud fell %.4f mm by t = %.3f s, horizontal "
+                 "extent %.4f mm." % (1e3 * fallen, reference["time"],
+                                      1e3 * reference["width"]))
+    table = "\n".join(lines) + "\n"
+    print(table)
+    with open(os.path.join(args.out, "table.md"), "w") as f:
+        f.write(table)
+    plot(results, reference, os.path.join(args.out, "speed_accuracy_cloud_2d.png"))
+
+
+if __name__ == "__main__":
+    main()
