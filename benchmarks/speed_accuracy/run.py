@@ -22,6 +22,8 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from scene_runner import ROOT, read_csv, run_scene  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pareto import plot_pareto  # noqa: E402
 
 SCENE = os.path.join(ROOT, "prm", "falling_cloud_2d.prm")
 WORK = os.path.join(ROOT, "benchmarks", "results", "speed_accuracy")
@@ -99,39 +101,6 @@ def run(name, end):
                 time=float(last["time"]))
 
 
-def plot(results, reference, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    points = [(r["run"], max(r["error"], 1e-4), r["name"])
-              for r in results if r["name"] != "reference"]
-    for wall, error, name in points:
-        ax.plot(wall, error, "*" if name == "default" else "o",
-                color="C3" if name == "default" else "C0",
-                markersize=11 if name == "default" else 6)
-        ax.annotate(name, (wall, error), fontsize=7,
-                    xytext=(3, 3), textcoords="offset points")
-    # Pareto front: no other point both faster and more accurate.
-    front = sorted((p for p in points
-                    if not any(q[0] <= p[0] and q[1] < p[1] or
-                               q[0] < p[0] and q[1] <= p[1] for q in points)),
-                   key=lambda p: p[0])
-    ax.plot([p[0] for p in front], [p[1] for p in front], "-", color="C3",
-            label="Pareto front")
-    ax.axvline(reference["run"], color="grey", ls=":",
-               label="reference run (%.0f s)" % reference["run"])
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("wall time after set-up [s], one core")
-    ax.set_ylabel("centroid error [% of the distance fallen]")
-    ax.set_title("2D falling cloud to t = %.2f s: error against cost"
-                 % reference["time"])
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--end", type=float, default=0.3)
@@ -174,7 +143,11 @@ def main():
     print(table)
     with open(os.path.join(args.out, "table.md"), "w") as f:
         f.write(table)
-    plot(results, reference, os.path.join(args.out, "speed_accuracy_cloud_2d.png"))
+    plot_pareto(results, reference["run"],
+                os.path.join(args.out, "speed_accuracy_cloud_2d.png"),
+                "2D falling cloud to t = %.2f s: error against cost"
+                % reference["time"],
+                "centroid error [% of the distance fallen]")
 
 
 if __name__ == "__main__":
