@@ -4,17 +4,19 @@ drivers of this directory."""
 
 def plot_pareto(results, reference_wall, path, title, ylabel):
     """@p results: dicts with name, run (wall seconds) and error (percent);
-    the entry named "reference" is left out, "default" is starred."""
+    the entry named "reference" is left out, the default (named so, or
+    marked "default") is starred."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    points = [(r["run"], max(r["error"], 1e-4), r["name"])
+    points = [(r["run"], max(r["error"], 1e-4), r["name"],
+               r["name"] == "default" or r.get("default", False))
               for r in results if r["name"] != "reference"]
-    for wall, error, name in points:
-        ax.plot(wall, error, "*" if name == "default" else "o",
-                color="C3" if name == "default" else "C0",
-                markersize=11 if name == "default" else 6)
+    for wall, error, name, default in points:
+        ax.plot(wall, error, "*" if default else "o",
+                color="C3" if default else "C0",
+                markersize=11 if default else 6)
         ax.annotate(name, (wall, error), fontsize=7,
                     xytext=(3, 3), textcoords="offset points")
     # Pareto front: no other point both faster and more accurate.

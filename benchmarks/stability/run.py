@@ -79,13 +79,15 @@ def terminal(r, rho, rho_p, mu, dim, eps=1.0):
 
 def lone_grain(dim, r=12.5e-6, rho=1200.0, rho_p=2400.0, mu=0.12,
                cell_diameters=8.0, dt_over_tau=None, dt=1e-3,
-               navier_stokes=False, smoothing_diameters=0.0):
+               navier_stokes=False, smoothing_diameters=0.0, cells=None,
+               correction=False):
     """Parameter text, the analytical velocity (signed, along gravity's
     axis) and the number of fluid steps of a lone grain settling."""
     d = 2 * r
     # At least 16 diameters across, so that small cells do not make a box
     # the grain barely fits in.
-    cells = max(8 if dim == 3 else 16, math.ceil(16 / cell_diameters))
+    if cells is None:
+        cells = max(8 if dim == 3 else 16, math.ceil(16 / cell_diameters))
     h = cell_diameters * d
     L = cells * h
     U, reynolds, tau = terminal(r, rho, rho_p, mu, dim)
@@ -125,7 +127,8 @@ subsection Fluid
   set Time derivative = {str(navier_stokes).lower()}
 end
 subsection Coupling
-{coupling}end
+{coupling}  set Self-disturbance correction = {str(correction).lower()}
+end
 subsection Grains
   set Enabled = true
   set Radius  = {r}
