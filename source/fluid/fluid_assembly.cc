@@ -2,10 +2,11 @@
 #include <cmath>
 #include <limits>
 
-#include <deal.II/base/qprojector.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
 
+#include <immersed_grains/fluid/assembly_terms.h>
+#include <immersed_grains/fluid/cell_gather.h>
 #include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
@@ -44,6 +45,55 @@ namespace ImmersedGrains
           beta > 0 ? momentum / beta : dealii::Tensor<1, dim>();
       }
     }
+
+    // K_ab += N_a w_b + viscous grad N_a . grad N_b for all pairs: the
+    // assembly's innermost loop, n_s^2 entries at every quadrature point
+    // (729 in 3D). Compiled also for AVX2 and chosen when the processor
+    // has it (GCC's function multiversioning), since deal.II's Debian
+    // build targets generic x86-64 (two doubles per instruction). Without
+    // FMA contraction, and with each entry's sum in the same order, both
+    // versions give the same bits.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+    __attribute__((target_clones("avx2", "default")))
+#endif
+    void
+    add_to_velocity_block(const unsigned int n_s,
+                          const unsigned int dim,
+                          const double *__restrict N,
+                          const double *__restrict G0,
+                          const double *__restrict G1,
+                          const double *__restrict G2,
+                          const double *__restrict w,
+                          const double viscous,
+                          double *__restrict K)
+    {
+      for (unsigned int a = 0; a < n_s; ++a)
+      {
+        double *__restrict row = K + a * n_s;
+        const double Na = N[a], Ga0 = G0[a], Ga1 = G1[a];
+        if (dim == 2)
+          for (unsigned int b = 0; b < n_s; ++b)
+          {
+            double g = 0;
+            g += Ga0 * G0[b];
+            g += Ga1 * G1[b];
+            row[b] += Na * w[b] + viscous * g;
+          }
+        else
+        {
+          const double Ga2 = G2[a];
+          for (unsigned int b = 0; b < n_s; ++b)
+          {
+            double g = 0;
+            g += Ga0 * G0[b];
+            g += Ga1 * G1[b];
+            g += Ga2 * G2[b];
+            row[b] += Na * w[b] + viscous * g;
+          }
+        }
+      }
+    }
+
 
     // The floor on the mass-and-drag coefficient c of S_c where c vanishes
     // (block_preconditioner.h), as a fraction of the viscous diagonal, for
@@ -125,10 +175,8 @@ namespace ImmersedGrains
    *       + <phi p_open, v.n>_open
    *   R_p = -(q, div(phi u) - g) + (grad q, s) - <q, s.n>_{open, velocity},
    *
-   * s = (1 - phi) u_p the solid volume flux (integrated by parts: walls
-   * let no grain through),
-   * with div(phi v) = phi div v + grad phi . v, so that the pressure and the
-   * continuity blocks are transposes of each other.
+   * one AssemblyTerm per term (assembly_terms.h), listed for the scene by
+   * make_assembly_terms(): a term the scene switches off is not visited.
    *
    * Each Taylor-Hood velocity shape function has one non-zero component, a
    * scalar Q2 function N_a times a unit vector. Every term but Newton's
@@ -137,7 +185,9 @@ namespace ImmersedGrains
    * matrix K and copied onto the dim diagonal blocks; the pressure coupling
    * B (and its transpose) as dim n_s x n_p matrices. This does about a
    * tenth of the work of a loop over all pairs of vector-valued shape
-   * functions (doc/performance.md).
+   * functions (doc/performance.md). The momentum terms only state their
+   * coefficients at each point (MomentumCoefficients); the kernel below
+   * integrates them in one pass over K, whichever terms contributed.
    */
   template <int dim>
   void
@@ -153,34 +203,17 @@ namespace ImmersedGrains
       reaction_diagonal    = 0;
     }
 
-    const dealii::QGauss<dim>     quadrature(fe.degree + 1);
-    const dealii::QGauss<dim - 1> face_quadrature(fe.degree + 1);
-    dealii::FEValues<dim>         fe_values(mapping,
+    const dealii::QGauss<dim> quadrature(fe.degree + 1);
+    dealii::FEValues<dim>     fe_values(mapping,
                                     fe,
                                     quadrature,
                                     dealii::update_values |
                                       dealii::update_gradients |
                                       dealii::update_quadrature_points |
                                       dealii::update_JxW_values);
-    dealii::FEFaceValues<dim>     fe_face_values(
-      mapping,
-      fe,
-      face_quadrature,
-      dealii::update_values | dealii::update_normal_vectors |
-        dealii::update_quadrature_points | dealii::update_JxW_values);
-
-    // Face quadrature points in reference-cell coordinates, per face.
-    std::vector<std::vector<dealii::Point<dim>>> face_reference_points;
-    for (const unsigned int f : dealii::GeometryInfo<dim>::face_indices())
-      face_reference_points.push_back(
-        dealii::QProjector<dim>::project_to_face(
-          dealii::ReferenceCells::get_hypercube<dim>(), face_quadrature, f)
-          .get_points());
 
     const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
     const unsigned int n_q           = quadrature.size();
-    const dealii::FEValuesExtractors::Vector velocities(0);
-    const dealii::FEValuesExtractors::Scalar pressure(dim);
 
     // Local index of velocity component c of scalar Q2 function a, and of
     // pressure function b.
@@ -197,49 +230,46 @@ namespace ImmersedGrains
         pressure_dof[index] = k;
     }
 
+    const double rho = parameters.density, mu = parameters.viscosity;
+    const double inv_dt =
+      (parameters.time_derivative && dt > 0) ? 1.0 / dt : 0.0;
+    forcing->set_time(time);
+
+    double                 max_beta = 0;
+    const AssemblyTermList terms =
+      make_assembly_terms(rho, mu, inv_dt, max_beta);
+    const bool convection            = terms.convects;
+    const bool convection_derivative = terms.linearises_convection;
+
     dealii::FullMatrix<double> cell_matrix(dofs_per_cell, dofs_per_cell);
     dealii::FullMatrix<double> cell_mass(dofs_per_cell, dofs_per_cell);
     dealii::Vector<double>     cell_rhs(dofs_per_cell);
     dealii::Vector<double>     cell_reaction(dofs_per_cell);
     const double               box_size = geometry.shortest_side();
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
-    std::vector<PointDrag<dim>>                  drags;
-    std::vector<double>                          point_shape(dofs_per_cell);
     std::vector<double>                          local_solution(dofs_per_cell);
     std::vector<double> local_old(dofs_per_cell), local_older(dofs_per_cell);
 
-    // Scalar shape data at one quadrature point: N_a, grad N_a by
-    // coordinate (contiguous, so the pair loops vectorise), and the same
-    // for the pressure functions.
-    std::vector<double>                  N(n_s), Np(n_p);
-    std::array<std::vector<double>, dim> G, Gp;
-    for (unsigned int d = 0; d < dim; ++d)
-    {
-      G[d].resize(n_s);
-      Gp[d].resize(n_p);
-    }
-    // Cell integrals: K (velocity block of one component), W (Newton's
-    // cross terms, dim x dim blocks), B (velocity-pressure coupling per
-    // component, also the continuity block's transpose), C (pressure
-    // mobility), Mp (weighted pressure mass), R (mass-and-drag diagonal).
-    std::vector<double> K(n_s * n_s), B(dim * n_s * n_p), C(n_p * n_p),
-      Mp(n_p * n_p), R(n_s), advection_weight(n_s);
-    std::vector<double> W(parameters.newton ? dim * dim * n_s * n_s : 0);
-    std::vector<dealii::Tensor<1, dim>> rhs_u(n_s);
-    std::vector<double>                 rhs_p(n_p);
+    ScalarShapes<dim> shapes;
+    shapes.resize(n_s, n_p);
+    CellIntegrals integrals;
+    integrals.resize(dim, n_s, n_p, convection_derivative);
+    std::vector<double> advection_weight(n_s);
+    CellContext<dim>    context;
+    context.fe_values             = &fe_values;
+    context.preconditioner_pieces = assemble_preconditioner_matrices;
+    context.velocity.resize(n_s * dim);
 
     std::vector<dealii::Vector<double>> f(n_q, dealii::Vector<double>(dim));
     MixtureValues<dim>                  mixture;
+    PointState<dim>                     state;
+    const bool                          with_history = inv_dt > 0;
 
-    const double rho = parameters.density, mu = parameters.viscosity;
-    const double inv_dt =
-      (parameters.time_derivative && dt > 0) ? 1.0 / dt : 0.0;
-    const bool advection = parameters.advection;
-    const bool newton    = parameters.newton && advection;
-    forcing->set_time(time);
-    parameters.open_boundary_pressure->set_time(time);
+    AssertThrow(cell_gather->matches(solution) &&
+                  cell_gather->matches(old_solution) &&
+                  cell_gather->matches(old_old_solution),
+                dealii::ExcInternalError());
 
-    double       max_beta       = 0;
     unsigned int averaged_cells = 0;
     // The largest ratio of the viscous and advective parts of A to its
     // mass-and-drag part, at the spacing of the velocity nodes: where it
@@ -253,26 +283,13 @@ namespace ImmersedGrains
         continue;
       const unsigned int cell_number = owned_cell++;
       fe_values.reinit(cell);
-      cell->get_dof_indices(dof_indices);
-      for (unsigned int k = 0; k < dofs_per_cell; ++k)
-        local_solution[k] = solution(dof_indices[k]);
-      if (inv_dt > 0)
-        for (unsigned int k = 0; k < dofs_per_cell; ++k)
-        {
-          local_old[k]   = old_solution(dof_indices[k]);
-          local_older[k] = old_old_solution(dof_indices[k]);
-        }
-      std::fill(K.begin(), K.end(), 0.0);
-      std::fill(B.begin(), B.end(), 0.0);
-      std::fill(C.begin(), C.end(), 0.0);
-      std::fill(W.begin(), W.end(), 0.0);
-      std::fill(rhs_u.begin(), rhs_u.end(), dealii::Tensor<1, dim>());
-      std::fill(rhs_p.begin(), rhs_p.end(), 0.0);
-      if (assemble_preconditioner_matrices)
+      cell_gather->gather(cell_number, solution, local_solution);
+      if (with_history)
       {
-        std::fill(Mp.begin(), Mp.end(), 0.0);
-        std::fill(R.begin(), R.end(), 0.0);
+        cell_gather->gather(cell_number, old_solution, local_old);
+        cell_gather->gather(cell_number, old_old_solution, local_older);
       }
+      integrals.clear(assemble_preconditioner_matrices);
       // Integrals of the drag coefficient field and of the viscosity phi mu
       // over the cell, for drag_cell_mass_factor. Not the grains' point or
       // cell drag: rank one per grain or cell, it leaves the cell's other
@@ -296,152 +313,121 @@ namespace ImmersedGrains
         average_drag_over_cell(fe_values, mixture);
         ++averaged_cells;
       }
-      forcing->vector_value_list(fe_values.get_quadrature_points(), f);
+      if (terms.forcing)
+        forcing->vector_value_list(fe_values.get_quadrature_points(), f);
 
       for (unsigned int q = 0; q < n_q; ++q)
       {
         for (unsigned int a = 0; a < n_s; ++a)
         {
           const unsigned int k = velocity_dof[a][0];
-          N[a]                 = fe_values.shape_value(k, q);
+          shapes.N[a]          = fe_values.shape_value(k, q);
           const auto grad      = fe_values.shape_grad(k, q);
           for (unsigned int d = 0; d < dim; ++d)
-            G[d][a] = grad[d];
+            shapes.G[d][a] = grad[d];
         }
         for (unsigned int b = 0; b < n_p; ++b)
         {
           const unsigned int k = pressure_dof[b];
-          Np[b]                = fe_values.shape_value(k, q);
+          shapes.Np[b]         = fe_values.shape_value(k, q);
           const auto grad      = fe_values.shape_grad(k, q);
           for (unsigned int d = 0; d < dim; ++d)
-            Gp[d][b] = grad[d];
+            shapes.Gp[d][b] = grad[d];
         }
+        const auto &N = shapes.N;
+        const auto &G = shapes.G;
 
         // The current iterate and the history at this point.
-        dealii::Tensor<1, dim> u, u_history;
-        dealii::Tensor<2, dim> grad_u;
-        double                 p = 0;
-        dealii::Tensor<1, dim> grad_p;
+        state.u         = dealii::Tensor<1, dim>();
+        state.u_history = dealii::Tensor<1, dim>();
+        state.grad_u    = dealii::Tensor<2, dim>();
+        state.p         = 0;
+        state.grad_p    = dealii::Tensor<1, dim>();
         for (unsigned int a = 0; a < n_s; ++a)
           for (unsigned int c = 0; c < dim; ++c)
           {
             const unsigned int k = velocity_dof[a][c];
-            u[c] += local_solution[k] * N[a];
+            state.u[c] += local_solution[k] * N[a];
             for (unsigned int d = 0; d < dim; ++d)
-              grad_u[c][d] += local_solution[k] * G[d][a];
-            if (inv_dt > 0)
-              u_history[c] +=
+              state.grad_u[c][d] += local_solution[k] * G[d][a];
+            if (with_history)
+              state.u_history[c] +=
                 (bdf[1] * local_old[k] + bdf[2] * local_older[k]) * N[a];
           }
         for (unsigned int b = 0; b < n_p; ++b)
         {
           const double value = local_solution[pressure_dof[b]];
-          p += value * Np[b];
+          state.p += value * shapes.Np[b];
           for (unsigned int d = 0; d < dim; ++d)
-            grad_p[d] += value * Gp[d][b];
+            state.grad_p[d] += value * shapes.Gp[d][b];
         }
+        state.phi            = mixture.fluid_fraction[q];
+        state.grad_phi       = mixture.fluid_fraction_gradient[q];
+        state.beta           = mixture.drag_coefficient[q];
+        state.grain_velocity = mixture.grain_velocity[q];
+        state.solid_flux     = mixture.solid_flux[q];
+        state.mass_source    = mixture.mass_source[q];
+        state.alpha          = mixture.pressure_gradient_weight[q];
+        state.mobility       = mixture.pressure_mobility[q];
+        if (terms.forcing)
+          for (unsigned int d = 0; d < dim; ++d)
+            state.forcing[d] = f[q](d);
+        const double JxW = fe_values.JxW(q);
 
-        const double phi      = mixture.fluid_fraction[q];
-        const auto  &grad_phi = mixture.fluid_fraction_gradient[q];
-        const double beta     = mixture.drag_coefficient[q];
-        const double alpha    = mixture.pressure_gradient_weight[q];
-        const double mobility = mixture.pressure_mobility[q];
-        const double mass     = phi * rho * bdf[0] * inv_dt;
-        const double JxW      = fe_values.JxW(q);
+        MomentumCoefficients<dim> m;
+        for (const auto *term : terms.at_points)
+          term->point(state, shapes, JxW, m, integrals);
 
-        // Strong-form pieces of the residual at this point.
-        dealii::Tensor<1, dim> momentum =
-          phi * rho * inv_dt * (bdf[0] * u + u_history) +
-          beta * (u - mixture.grain_velocity[q]) + alpha * grad_p;
-        if (advection)
-          momentum += phi * rho * (grad_u * u);
-        for (unsigned int d = 0; d < dim; ++d)
-          momentum[d] -= f[q](d);
-        const dealii::Tensor<2, dim> viscous = phi * mu * grad_u;
-        // The solid flux enters integrated by parts, (grad q, s): its
-        // normal component is then zero on walls, where grains cannot pass,
-        // and the continuity equation stays compatible with a pressure
-        // fixed only up to a constant.
-        const double continuity =
-          phi * dealii::trace(grad_u) + grad_phi * u - mixture.mass_source[q];
-        const dealii::Tensor<1, dim> solid_flux =
-          mixture.solid_flux[q] + alpha * u - mobility * grad_p;
-
-        // Velocity rows: momentum and viscous stress against N_a, pressure
-        // against div(phi N_a e_c) = phi dN_a/dx_c + dphi/dx_c N_a.
+        // Velocity rows: force and stress against N_a and grad N_a, the
+        // pressure against div(phi N_a e_c) = phi dN_a/dx_c + dphi/dx_c N_a.
         for (unsigned int a = 0; a < n_s; ++a)
           for (unsigned int c = 0; c < dim; ++c)
           {
-            double viscous_a = 0;
+            double stress_a = 0;
             for (unsigned int d = 0; d < dim; ++d)
-              viscous_a += viscous[c][d] * G[d][a];
-            rhs_u[a][c] -= (momentum[c] * N[a] + viscous_a -
-                            p * (phi * G[c][a] + grad_phi[c] * N[a])) *
-                           JxW;
+              stress_a += m.stress[c][d] * G[d][a];
+            integrals.rhs_u[a * dim + c] -=
+              (m.force[c] * N[a] + stress_a -
+               m.pressure * (state.phi * G[c][a] + state.grad_phi[c] * N[a])) *
+              JxW;
           }
-        for (unsigned int b = 0; b < n_p; ++b)
-        {
-          double flux_b = 0;
-          for (unsigned int d = 0; d < dim; ++d)
-            flux_b += Gp[d][b] * solid_flux[d];
-          rhs_p[b] -= (-Np[b] * continuity + flux_b) * JxW;
-        }
 
-        // K_ab += (mass + beta) N_a N_b + phi mu grad N_a . grad N_b
-        //       + phi rho (u . grad N_b) N_a.
-        const double w_mass    = (mass + beta) * JxW;
-        const double w_viscous = phi * mu * JxW;
+        // K_ab += reaction N_a N_b + diffusion grad N_a . grad N_b
+        //       + convection_weight (convection . grad N_b) N_a.
+        const double w_mass    = m.reaction * JxW;
+        const double w_viscous = m.diffusion * JxW;
         for (unsigned int b = 0; b < n_s; ++b)
         {
-          double adv = 0;
-          if (advection)
-            for (unsigned int d = 0; d < dim; ++d)
-              adv += u[d] * G[d][b];
-          advection_weight[b] = w_mass * N[b] + phi * rho * adv * JxW;
-        }
-        for (unsigned int a = 0; a < n_s; ++a)
-        {
-          double *row = &K[a * n_s];
-          for (unsigned int b = 0; b < n_s; ++b)
+          advection_weight[b] = w_mass * N[b];
+          if (convection)
           {
-            double g = 0;
+            double adv = 0;
             for (unsigned int d = 0; d < dim; ++d)
-              g += G[d][a] * G[d][b];
-            row[b] += N[a] * advection_weight[b] + w_viscous * g;
+              adv += m.convection[d] * G[d][b];
+            advection_weight[b] += m.convection_weight * adv * JxW;
           }
         }
-        if (newton)
-          // phi rho (grad u)_cd N_b N_a couples component c of the row
-          // with component d of the column.
+        add_to_velocity_block(n_s,
+                              dim,
+                              N.data(),
+                              G[0].data(),
+                              G[1].data(),
+                              dim == 3 ? G[dim - 1].data() : nullptr,
+                              advection_weight.data(),
+                              w_viscous,
+                              integrals.K.data());
+        if (convection_derivative)
+          // convection_weight (grad u)_cd N_b N_a couples component c of
+          // the row with component d of the column.
           for (unsigned int c = 0; c < dim; ++c)
             for (unsigned int d = 0; d < dim; ++d)
             {
-              const double w     = phi * rho * grad_u[c][d] * JxW;
-              double      *block = &W[(c * dim + d) * n_s * n_s];
+              const double w =
+                m.convection_weight * m.convection_derivative[c][d] * JxW;
+              double *block = &integrals.W[(c * dim + d) * n_s * n_s];
               for (unsigned int a = 0; a < n_s; ++a)
                 for (unsigned int b = 0; b < n_s; ++b)
                   block[a * n_s + b] += w * N[a] * N[b];
-            }
-
-        // B_{c,ab} = -Np_b (phi dN_a/dx_c + dphi/dx_c N_a)
-        //          + alpha dNp_b/dx_c N_a.
-        for (unsigned int c = 0; c < dim; ++c)
-          for (unsigned int a = 0; a < n_s; ++a)
-          {
-            const double div_a   = (phi * G[c][a] + grad_phi[c] * N[a]) * JxW;
-            const double alpha_a = alpha * N[a] * JxW;
-            double      *row     = &B[(c * n_s + a) * n_p];
-            for (unsigned int b = 0; b < n_p; ++b)
-              row[b] += -Np[b] * div_a + alpha_a * Gp[c][b];
-          }
-        if (mobility != 0)
-          for (unsigned int b = 0; b < n_p; ++b)
-            for (unsigned int e = 0; e < n_p; ++e)
-            {
-              double g = 0;
-              for (unsigned int d = 0; d < dim; ++d)
-                g += Gp[d][b] * Gp[d][e];
-              C[b * n_p + e] -= mobility * g * JxW;
             }
 
         if (assemble_preconditioner_matrices)
@@ -450,30 +436,46 @@ namespace ImmersedGrains
           // needs the pressure mass matrix weighted by phi/mu and the
           // diagonal of the mass-and-drag part c M of A,
           // c = phi rho a0/dt + beta, plus its floor (schur_floor_factor).
+          const double phi            = state.phi;
           const double mass_weight    = phi / mu * JxW;
-          const double c              = mass + beta;
+          const double c              = m.reaction;
           const double spacing        = h / fe.degree;
           double       viscous_number = c > 0 ?
-                                          phi * mu / (c * spacing * spacing) :
+                                          m.diffusion / (c * spacing * spacing) :
                                           std::numeric_limits<double>::infinity();
-          if (advection && c > 0)
+          if (convection && c > 0)
             viscous_number =
-              std::max(viscous_number, phi * rho * u.norm() / (c * spacing));
+              std::max(viscous_number,
+                       m.convection_weight * state.u.norm() / (c * spacing));
           max_viscous_number = std::max(max_viscous_number, viscous_number);
-          cell_drag += beta * JxW;
-          cell_viscosity += phi * mu * JxW;
-          max_beta = std::max(max_beta, beta);
+          cell_drag += state.beta * JxW;
+          cell_viscosity += m.diffusion * JxW;
+          max_beta = std::max(max_beta, state.beta);
           for (unsigned int b = 0; b < n_p; ++b)
             for (unsigned int e = 0; e < n_p; ++e)
-              Mp[b * n_p + e] += mass_weight * Np[b] * Np[e];
+              integrals.Mp[b * n_p + e] +=
+                mass_weight * shapes.Np[b] * shapes.Np[e];
           for (unsigned int a = 0; a < n_s; ++a)
           {
             double g = 0;
             for (unsigned int d = 0; d < dim; ++d)
               g += G[d][a] * G[d][a];
-            R[a] += w_mass * N[a] * N[a] + floor_factor * w_viscous * g;
+            integrals.R[a] +=
+              w_mass * N[a] * N[a] + floor_factor * w_viscous * g;
           }
         }
+      }
+
+      // Grains at points and boundary faces.
+      if (!terms.on_cells.empty())
+      {
+        context.cell = cell;
+        context.h    = h;
+        for (unsigned int a = 0; a < n_s; ++a)
+          for (unsigned int c = 0; c < dim; ++c)
+            context.velocity[a * dim + c] = local_solution[velocity_dof[a][c]];
+        for (const auto *term : terms.on_cells)
+          term->cell(context, integrals);
       }
 
       // The scalar integrals onto the vector-valued cell matrix.
@@ -482,26 +484,36 @@ namespace ImmersedGrains
         for (unsigned int a = 0; a < n_s; ++a)
         {
           const unsigned int i = velocity_dof[a][c];
-          cell_rhs(i)          = rhs_u[a][c];
+          cell_rhs(i)          = integrals.rhs_u[a * dim + c];
           for (unsigned int b = 0; b < n_s; ++b)
-            cell_matrix(i, velocity_dof[b][c]) = K[a * n_s + b];
-          if (newton)
+            cell_matrix(i, velocity_dof[b][c]) = integrals.K[a * n_s + b];
+          if (convection_derivative)
             for (unsigned int d = 0; d < dim; ++d)
               for (unsigned int b = 0; b < n_s; ++b)
                 cell_matrix(i, velocity_dof[b][d]) +=
-                  W[(c * dim + d) * n_s * n_s + a * n_s + b];
+                  integrals.W[(c * dim + d) * n_s * n_s + a * n_s + b];
           for (unsigned int b = 0; b < n_p; ++b)
           {
-            const double value              = B[(c * n_s + a) * n_p + b];
+            const double value = integrals.B[(c * n_s + a) * n_p + b];
             cell_matrix(i, pressure_dof[b]) = value;
             cell_matrix(pressure_dof[b], i) = value;
           }
         }
       for (unsigned int b = 0; b < n_p; ++b)
       {
-        cell_rhs(pressure_dof[b]) = rhs_p[b];
+        cell_rhs(pressure_dof[b]) = integrals.rhs_p[b];
         for (unsigned int e = 0; e < n_p; ++e)
-          cell_matrix(pressure_dof[b], pressure_dof[e]) = C[b * n_p + e];
+          cell_matrix(pressure_dof[b], pressure_dof[e]) =
+            integrals.C[b * n_p + e];
+      }
+
+      if (cell_scatter->is_direct(cell_number))
+        cell_scatter->add(cell_number, cell_matrix, cell_rhs);
+      else
+      {
+        cell->get_dof_indices(dof_indices);
+        update_constraints.distribute_local_to_global(
+          cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
       }
       if (assemble_preconditioner_matrices)
       {
@@ -509,133 +521,15 @@ namespace ImmersedGrains
         cell_reaction = 0;
         for (unsigned int b = 0; b < n_p; ++b)
           for (unsigned int e = 0; e < n_p; ++e)
-            cell_mass(pressure_dof[b], pressure_dof[e]) = Mp[b * n_p + e];
+            cell_mass(pressure_dof[b], pressure_dof[e]) =
+              integrals.Mp[b * n_p + e];
         for (unsigned int a = 0; a < n_s; ++a)
           for (unsigned int c = 0; c < dim; ++c)
-            cell_reaction(velocity_dof[a][c]) = R[a];
-      }
-
-      // Grains in this cell: beta_i (u(x_i) - v_i) . N_k(x_i), implicit.
-      if (point_drag_source)
-      {
-        drags.clear();
-        point_drag_source->point_drags(cell, drags);
-        if (cell_averaged_drag && !drags.empty())
-        {
-          // The cell averages of the velocity shape functions: the drag of
-          // each grain spread evenly over its cell and felt against the
-          // cell-mean velocity. Every grain of the cell has the same
-          // shape, so their drags add up to one: sum beta_i against the
-          // cell-mean velocity minus sum beta_i v_i.
-          double volume = 0;
-          std::fill(point_shape.begin(), point_shape.end(), 0.0);
-          for (unsigned int q = 0; q < n_q; ++q)
-          {
-            volume += fe_values.JxW(q);
-            for (unsigned int a = 0; a < n_s; ++a)
-              point_shape[velocity_dof[a][0]] +=
-                fe_values.shape_value(velocity_dof[a][0], q) * fe_values.JxW(q);
-          }
-          for (unsigned int a = 0; a < n_s; ++a)
-          {
-            const double mean = point_shape[velocity_dof[a][0]] / volume;
-            for (unsigned int c = 0; c < dim; ++c)
-              point_shape[velocity_dof[a][c]] = mean;
-          }
-          PointDrag<dim> total;
-          total.beta = 0;
-          for (const auto &drag : drags)
-          {
-            total.beta += drag.beta;
-            total.velocity += drag.beta * drag.velocity;
-            max_beta = std::max(max_beta, drag.beta);
-          }
-          // total.velocity holds sum beta_i v_i.
-          drags.assign(1, total);
-        }
-        for (const auto &drag : drags)
-        {
-          if (!cell_averaged_drag)
-            for (unsigned int k = 0; k < dofs_per_cell; ++k)
-            {
-              const unsigned int c = fe.system_to_component_index(k).first;
-              point_shape[k] =
-                c < dim ? fe.shape_value(k, drag.reference_location) : 0.0;
-            }
-          dealii::Tensor<1, dim> u_at_grain;
-          for (unsigned int k = 0; k < dofs_per_cell; ++k)
-            if (point_shape[k] != 0)
-              u_at_grain[fe.system_to_component_index(k).first] +=
-                local_solution[k] * point_shape[k];
-          // The slip force beta (u - v); with the cell's grains summed,
-          // sum beta_i u - sum beta_i v_i.
-          const dealii::Tensor<1, dim> force =
-            cell_averaged_drag ? drag.beta * u_at_grain - drag.velocity :
-                                 drag.beta * (u_at_grain - drag.velocity);
-          for (unsigned int i = 0; i < dofs_per_cell; ++i)
-          {
-            if (point_shape[i] == 0)
-              continue;
-            const unsigned int ci = fe.system_to_component_index(i).first;
-            cell_rhs(i) -= force[ci] * point_shape[i];
-            for (unsigned int j = 0; j < dofs_per_cell; ++j)
-              if (point_shape[j] != 0 &&
-                  fe.system_to_component_index(j).first == ci)
-                cell_matrix(i, j) +=
-                  drag.beta * point_shape[i] * point_shape[j];
-            if (assemble_preconditioner_matrices)
-            {
-              cell_reaction(i) += drag.beta * point_shape[i] * point_shape[i];
-              max_beta = std::max(max_beta, drag.beta);
-            }
-          }
-        }
-      }
-
-      // Open faces: the weakly imposed pressure. Open and velocity faces:
-      // the solid flux that crosses them, -<q, s.n> (walls let none pass).
-      for (const unsigned int face_no : cell->face_indices())
-      {
-        const auto face = cell->face(face_no);
-        if (!face->at_boundary())
-          continue;
-        const BoundaryType type = geometry.boundary_types[face->boundary_id()];
-        if (type != BoundaryType::open && type != BoundaryType::velocity)
-          continue;
-        fe_face_values.reinit(cell, face_no);
-        MixtureValues<dim> face_mixture;
-        mixture_fields->evaluate(cell,
-                                 fe_face_values.get_quadrature_points(),
-                                 face_reference_points[face_no],
-                                 time,
-                                 face_mixture);
-        for (unsigned int q = 0; q < face_quadrature.size(); ++q)
-        {
-          const auto  &n       = fe_face_values.normal_vector(q);
-          const double JxW     = fe_face_values.JxW(q);
-          const double outflux = face_mixture.solid_flux[q] * n;
-          const double p_open  = type == BoundaryType::open ?
-                                   parameters.open_boundary_pressure->value(
-                                    fe_face_values.quadrature_point(q)) :
-                                   0.0;
-          for (unsigned int i = 0; i < dofs_per_cell; ++i)
-            cell_rhs(i) -= (face_mixture.fluid_fraction[q] * p_open *
-                              (fe_face_values[velocities].value(i, q) * n) -
-                            fe_face_values[pressure].value(i, q) * outflux) *
-                           JxW;
-        }
-      }
-
-      if (cell_scatter->is_direct(cell_number))
-        cell_scatter->add(cell_number, cell_matrix, cell_rhs);
-      else
-        update_constraints.distribute_local_to_global(
-          cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
-      if (assemble_preconditioner_matrices)
-      {
+            cell_reaction(velocity_dof[a][c]) = integrals.R[a];
         if (cell_drag > 0)
           cell_mass *=
             drag_cell_mass_factor(cell_drag * h * h / cell_viscosity);
+        cell->get_dof_indices(dof_indices);
         pressure_mass_constraints.distribute_local_to_global(
           cell_mass, dof_indices, pressure_mass_matrix);
         update_constraints.distribute_local_to_global(cell_reaction,
@@ -660,8 +554,58 @@ namespace ImmersedGrains
   }
 
 
+  template <int dim>
+  typename FluidSolver<dim>::AssemblyTermList
+  FluidSolver<dim>::make_assembly_terms(const double rho,
+                                        const double mu,
+                                        const double inv_dt,
+                                        double      &max_beta) const
+  {
+    AssemblyTermList list;
+    const auto       add =
+      [&](std::unique_ptr<AssemblyTerm<dim>> term, const bool at_points)
+    {
+      (at_points ? list.at_points : list.on_cells).push_back(term.get());
+      list.convects |= term->convects();
+      list.linearises_convection |= term->linearises_convection();
+      list.owned.push_back(std::move(term));
+    };
+    // The order is the order in which the terms add to the residual.
+    if (inv_dt > 0)
+      add(std::make_unique<TimeDerivativeTerm<dim>>(rho, bdf[0], inv_dt), true);
+    add(std::make_unique<DragFieldTerm<dim>>(), true);
+    add(std::make_unique<PressureContinuityTerm<dim>>(), true);
+    if (parameters.advection)
+      add(std::make_unique<AdvectionTerm<dim>>(rho, parameters.newton), true);
+    if (!forcing_is_zero)
+    {
+      add(std::make_unique<ForcingTerm<dim>>(), true);
+      list.forcing = true;
+    }
+    add(std::make_unique<ViscousTerm<dim>>(mu), true);
+    if (point_drag_source)
+      add(std::make_unique<GrainDragTerm<dim>>(
+            *point_drag_source, fe, cell_averaged_drag, max_beta),
+          false);
+    if (BoundaryFluxTerm<dim>::needed(geometry))
+      add(std::make_unique<BoundaryFluxTerm<dim>>(
+            mapping,
+            fe,
+            geometry,
+            *mixture_fields,
+            *parameters.open_boundary_pressure,
+            time),
+          false);
+    return list;
+  }
+
+
   template void
   FluidSolver<2>::assemble_system(bool);
   template void
   FluidSolver<3>::assemble_system(bool);
+  template FluidSolver<2>::AssemblyTermList
+  FluidSolver<2>::make_assembly_terms(double, double, double, double &) const;
+  template FluidSolver<3>::AssemblyTermList
+  FluidSolver<3>::make_assembly_terms(double, double, double, double &) const;
 } // namespace ImmersedGrains

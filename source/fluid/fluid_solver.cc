@@ -10,7 +10,9 @@
 #include <deal.II/numerics/data_postprocessor.h>
 #include <deal.II/numerics/vector_tools.h>
 
+#include <immersed_grains/fluid/assembly_terms.h>
 #include <immersed_grains/fluid/block_preconditioner.h>
+#include <immersed_grains/fluid/cell_gather.h>
 #include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
@@ -124,6 +126,12 @@ namespace ImmersedGrains
           }())
       , boundary_velocity(parameters.boundary_velocity)
   {
+    if (parameters.forcing_is_constant)
+    {
+      dealii::Vector<double> value(dim);
+      forcing->vector_value(dealii::Point<dim>(), value);
+      forcing_is_zero = value.linfty_norm() == 0;
+    }
     mixture_fields = std::make_shared<PrescribedMixtureFields<dim>>(
       parameters.fluid_fraction,
       parameters.drag_coefficient,
@@ -241,7 +249,8 @@ namespace ImmersedGrains
   void
   FluidSolver<dim>::set_forcing(std::shared_ptr<dealii::Function<dim>> f)
   {
-    forcing = f;
+    forcing         = f;
+    forcing_is_zero = false;
   }
 
 
@@ -341,6 +350,8 @@ namespace ImmersedGrains
                          update_constraints,
                          system_matrix,
                          system_rhs);
+    cell_gather = std::make_unique<CellGather<dim>>();
+    cell_gather->reinit(dof_handler, solution);
     pcout << "  fluid: "
           << dealii::Utilities::MPI::min(cell_scatter->direct_fraction(),
                                          mpi_communicator) *

@@ -27,6 +27,10 @@ namespace ImmersedGrains
   class BlockSchurPreconditioner;
   template <int dim>
   class CellScatter;
+  template <int dim>
+  class CellGather;
+  template <int dim>
+  class AssemblyTerm;
 
   /**
    * The volume-averaged (VANS) fluid: interstitial velocity u and pressure p
@@ -184,6 +188,22 @@ namespace ImmersedGrains
     void
     assemble_system(bool assemble_preconditioner_matrices);
 
+    // The terms of the weak form that the scene needs (fluid_assembly.cc),
+    // those integrated at quadrature points and those added per cell.
+    struct AssemblyTermList
+    {
+      std::vector<std::unique_ptr<AssemblyTerm<dim>>> owned;
+      std::vector<const AssemblyTerm<dim> *>          at_points, on_cells;
+      bool                                            convects = false;
+      bool linearises_convection                               = false;
+      bool forcing                                             = false;
+    };
+    AssemblyTermList
+    make_assembly_terms(double  density,
+                        double  viscosity,
+                        double  inv_dt,
+                        double &max_beta) const;
+
     // Solves for newton_update; with @p fresh_preconditioner the
     // preconditioner is built first (its matrices must have been
     // assembled), else the kept one is used.
@@ -255,6 +275,8 @@ namespace ImmersedGrains
     bool                                        cell_averaged_drag = false;
     unsigned int drag_averaged_cells = 0; // in the last assembly
     std::shared_ptr<dealii::Function<dim>> forcing;
+    // A forcing given as zeros: its term is left out of the assembly.
+    bool                                   forcing_is_zero = false;
     std::shared_ptr<dealii::Function<dim>> boundary_velocity;
 
     double       time       = 0;
@@ -267,6 +289,8 @@ namespace ImmersedGrains
     // Direct insertion of the cell matrices where the constraints allow
     // it (cell_scatter.h), rebuilt with the matrix.
     std::unique_ptr<CellScatter<dim>> cell_scatter;
+    // Each owned cell's DoFs in the ghosted vectors (cell_gather.h).
+    std::unique_ptr<CellGather<dim>> cell_gather;
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
     // Whether any drag is present; without it and without inertia (steady

@@ -1,0 +1,457 @@
+#include <deal.II/base/qprojector.h>
+
+#include <immersed_grains/fluid/assembly_terms.h>
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  void
+  ScalarShapes<dim>::resize(const unsigned int n_velocity,
+                            const unsigned int n_pressure)
+  {
+    N.resize(n_velocity);
+    Np.resize(n_pressure);
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      G[d].resize(n_velocity);
+      Gp[d].resize(n_pressure);
+    }
+  }
+
+
+  void
+  CellIntegrals::resize(const unsigned int dim,
+                        const unsigned int n_velocity,
+                        const unsigned int n_pressure,
+                        const bool         newton)
+  {
+    n_s = n_velocity;
+    n_p = n_pressure;
+    K.resize(n_s * n_s);
+    W.resize(newton ? dim * dim * n_s * n_s : 0);
+    B.resize(dim * n_s * n_p);
+    C.resize(n_p * n_p);
+    rhs_u.resize(dim * n_s);
+    rhs_p.resize(n_p);
+    Mp.resize(n_p * n_p);
+    R.resize(n_s);
+  }
+
+
+  void
+  CellIntegrals::clear(const bool preconditioner_pieces)
+  {
+    for (auto *block : {&K, &W, &B, &C, &rhs_u, &rhs_p})
+      std::fill(block->begin(), block->end(), 0.0);
+    if (preconditioner_pieces)
+      for (auto *block : {&Mp, &R})
+        std::fill(block->begin(), block->end(), 0.0);
+  }
+
+
+  template <int dim>
+  void
+  AssemblyTerm<dim>::point(const PointState<dim> &,
+                           const ScalarShapes<dim> &,
+                           double,
+                           MomentumCoefficients<dim> &,
+                           CellIntegrals &) const
+  {
+  }
+
+
+  template <int dim>
+  void
+  AssemblyTerm<dim>::cell(const CellContext<dim> &, CellIntegrals &) const
+  {
+  }
+
+
+  template <int dim>
+  bool
+  AssemblyTerm<dim>::convects() const
+  {
+    return false;
+  }
+
+
+  template <int dim>
+  bool
+  AssemblyTerm<dim>::linearises_convection() const
+  {
+    return false;
+  }
+
+
+  template <int dim>
+  TimeDerivativeTerm<dim>::TimeDerivativeTerm(const double density,
+                                              const double a0,
+                                              const double inv_dt)
+      : density(density)
+      , a0(a0)
+      , inv_dt(inv_dt)
+  {
+  }
+
+
+  template <int dim>
+  void
+  TimeDerivativeTerm<dim>::point(const PointState<dim> &s,
+                                 const ScalarShapes<dim> &,
+                                 double,
+                                 MomentumCoefficients<dim> &m,
+                                 CellIntegrals &) const
+  {
+    // Matrix: phi rho a0/dt N_a N_b; residual: phi rho (a0 u + history)/dt.
+    m.reaction += s.phi * density * a0 * inv_dt;
+    m.force += s.phi * density * inv_dt * (a0 * s.u + s.u_history);
+  }
+
+
+  template <int dim>
+  void
+  DragFieldTerm<dim>::point(const PointState<dim> &s,
+                            const ScalarShapes<dim> &,
+                            double,
+                            MomentumCoefficients<dim> &m,
+                            CellIntegrals &) const
+  {
+    m.reaction += s.beta;
+    m.force += s.beta * (s.u - s.grain_velocity);
+  }
+
+
+  template <int dim>
+  ViscousTerm<dim>::ViscousTerm(const double viscosity)
+      : viscosity(viscosity)
+  {
+  }
+
+
+  template <int dim>
+  void
+  ViscousTerm<dim>::point(const PointState<dim> &s,
+                          const ScalarShapes<dim> &,
+                          double,
+                          MomentumCoefficients<dim> &m,
+                          CellIntegrals &) const
+  {
+    m.diffusion += s.phi * viscosity;
+    m.stress += s.phi * viscosity * s.grad_u;
+  }
+
+
+  template <int dim>
+  AdvectionTerm<dim>::AdvectionTerm(const double density, const bool newton)
+      : density(density)
+      , newton(newton)
+  {
+  }
+
+
+  template <int dim>
+  void
+  AdvectionTerm<dim>::point(const PointState<dim> &s,
+                            const ScalarShapes<dim> &,
+                            double,
+                            MomentumCoefficients<dim> &m,
+                            CellIntegrals &) const
+  {
+    // Picard: phi rho (u . grad du); Newton adds phi rho (grad u) du.
+    m.convection_weight = s.phi * density;
+    m.convection        = s.u;
+    if (newton)
+      m.convection_derivative = s.grad_u;
+    m.force += s.phi * density * (s.grad_u * s.u);
+  }
+
+
+  template <int dim>
+  bool
+  AdvectionTerm<dim>::convects() const
+  {
+    return true;
+  }
+
+
+  template <int dim>
+  bool
+  AdvectionTerm<dim>::linearises_convection() const
+  {
+    return newton;
+  }
+
+
+  template <int dim>
+  void
+  ForcingTerm<dim>::point(const PointState<dim> &s,
+                          const ScalarShapes<dim> &,
+                          double,
+                          MomentumCoefficients<dim> &m,
+                          CellIntegrals &) const
+  {
+    m.force -= s.forcing;
+  }
+
+
+  template <int dim>
+  void
+  PressureContinuityTerm<dim>::point(const PointState<dim>     &s,
+                                     const ScalarShapes<dim>   &shapes,
+                                     const double               JxW,
+                                     MomentumCoefficients<dim> &m,
+                                     CellIntegrals             &integrals) const
+  {
+    const unsigned int n_s = integrals.n_s, n_p = integrals.n_p;
+    m.force += s.alpha * s.grad_p;
+    m.pressure = s.p;
+
+    // Pressure rows: the continuity residual against Np_b, the total
+    // solid flux against grad Np_b.
+    const double continuity =
+      s.phi * dealii::trace(s.grad_u) + s.grad_phi * s.u - s.mass_source;
+    const dealii::Tensor<1, dim> solid_flux =
+      s.solid_flux + s.alpha * s.u - s.mobility * s.grad_p;
+    for (unsigned int b = 0; b < n_p; ++b)
+    {
+      double flux_b = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        flux_b += shapes.Gp[d][b] * solid_flux[d];
+      integrals.rhs_p[b] -= (-shapes.Np[b] * continuity + flux_b) * JxW;
+    }
+
+    // B_{c,ab} = -Np_b (phi dN_a/dx_c + dphi/dx_c N_a)
+    //          + alpha dNp_b/dx_c N_a.
+    for (unsigned int c = 0; c < dim; ++c)
+      for (unsigned int a = 0; a < n_s; ++a)
+      {
+        const double div_a =
+          (s.phi * shapes.G[c][a] + s.grad_phi[c] * shapes.N[a]) * JxW;
+        const double alpha_a = s.alpha * shapes.N[a] * JxW;
+        double      *row     = &integrals.B[(c * n_s + a) * n_p];
+        for (unsigned int b = 0; b < n_p; ++b)
+          row[b] += -shapes.Np[b] * div_a + alpha_a * shapes.Gp[c][b];
+      }
+    if (s.mobility != 0)
+      for (unsigned int b = 0; b < n_p; ++b)
+        for (unsigned int e = 0; e < n_p; ++e)
+        {
+          double g = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            g += shapes.Gp[d][b] * shapes.Gp[d][e];
+          integrals.C[b * n_p + e] -= s.mobility * g * JxW;
+        }
+  }
+
+
+  template <int dim>
+  GrainDragTerm<dim>::GrainDragTerm(const PointDragSource<dim>  &source,
+                                    const dealii::FESystem<dim> &fe,
+                                    const bool                   cell_averaged,
+                                    double                      &max_beta)
+      : source(source)
+      , element(fe.base_element(0))
+      , cell_averaged(cell_averaged)
+      , max_beta(max_beta)
+      , shape(element.n_dofs_per_cell())
+  {
+    first_component_dof.resize(element.n_dofs_per_cell());
+    for (unsigned int k = 0; k < fe.n_dofs_per_cell(); ++k)
+    {
+      const auto [component, index] = fe.system_to_component_index(k);
+      if (component == 0)
+        first_component_dof[index] = k;
+    }
+  }
+
+
+  template <int dim>
+  void
+  GrainDragTerm<dim>::cell(const CellContext<dim> &context,
+                           CellIntegrals          &integrals) const
+  {
+    drags.clear();
+    source.point_drags(context.cell, drags);
+    if (drags.empty())
+      return;
+    const unsigned int n_s = integrals.n_s;
+
+    if (cell_averaged)
+    {
+      // The cell averages of the velocity shape functions: the drag of
+      // each grain spread evenly over its cell and felt against the
+      // cell-mean velocity. Every grain of the cell has the same shape, so
+      // their drags add up to one: sum beta_i against the cell-mean
+      // velocity minus sum beta_i v_i.
+      const auto &fe_values = *context.fe_values;
+      double      volume    = 0;
+      std::fill(shape.begin(), shape.end(), 0.0);
+      for (const unsigned int q : fe_values.quadrature_point_indices())
+      {
+        volume += fe_values.JxW(q);
+        for (unsigned int a = 0; a < n_s; ++a)
+          shape[a] +=
+            fe_values.shape_value(first_component_dof[a], q) * fe_values.JxW(q);
+      }
+      for (unsigned int a = 0; a < n_s; ++a)
+        shape[a] /= volume;
+      PointDrag<dim> total;
+      total.beta = 0;
+      for (const auto &drag : drags)
+      {
+        total.beta += drag.beta;
+        total.velocity += drag.beta * drag.velocity;
+        max_beta = std::max(max_beta, drag.beta);
+      }
+      // total.velocity holds sum beta_i v_i.
+      drags.assign(1, total);
+    }
+
+    for (const auto &drag : drags)
+    {
+      if (!cell_averaged)
+        for (unsigned int a = 0; a < n_s; ++a)
+          shape[a] = element.shape_value(a, drag.reference_location);
+      dealii::Tensor<1, dim> u_at_grain;
+      for (unsigned int a = 0; a < n_s; ++a)
+        if (shape[a] != 0)
+          for (unsigned int c = 0; c < dim; ++c)
+            u_at_grain[c] += context.velocity[a * dim + c] * shape[a];
+      // The slip force beta (u - v); with the cell's grains summed,
+      // sum beta_i u - sum beta_i v_i.
+      const dealii::Tensor<1, dim> force =
+        cell_averaged ? drag.beta * u_at_grain - drag.velocity :
+                        drag.beta * (u_at_grain - drag.velocity);
+      max_beta = std::max(max_beta, drag.beta);
+      for (unsigned int a = 0; a < n_s; ++a)
+      {
+        if (shape[a] == 0)
+          continue;
+        for (unsigned int c = 0; c < dim; ++c)
+          integrals.rhs_u[a * dim + c] -= force[c] * shape[a];
+        double *row = &integrals.K[a * n_s];
+        for (unsigned int b = 0; b < n_s; ++b)
+          if (shape[b] != 0)
+            row[b] += drag.beta * shape[a] * shape[b];
+        if (context.preconditioner_pieces)
+          integrals.R[a] += drag.beta * shape[a] * shape[a];
+      }
+    }
+  }
+
+
+  template <int dim>
+  BoundaryFluxTerm<dim>::BoundaryFluxTerm(
+    const dealii::Mapping<dim>  &mapping,
+    const dealii::FESystem<dim> &fe,
+    const Geometry<dim>         &geometry,
+    const MixtureFields<dim>    &mixture_fields,
+    dealii::Function<dim>       &open_pressure,
+    const double                 time)
+      : geometry(geometry)
+      , mixture_fields(mixture_fields)
+      , open_pressure(open_pressure)
+      , time(time)
+      , quadrature(fe.degree + 1)
+      , fe_face_values(mapping,
+                       fe,
+                       quadrature,
+                       dealii::update_values | dealii::update_normal_vectors |
+                         dealii::update_quadrature_points |
+                         dealii::update_JxW_values)
+  {
+    open_pressure.set_time(time);
+    for (const unsigned int f : dealii::GeometryInfo<dim>::face_indices())
+      reference_points.push_back(
+        dealii::QProjector<dim>::project_to_face(
+          dealii::ReferenceCells::get_hypercube<dim>(), quadrature, f)
+          .get_points());
+    velocity_dof.resize(fe.base_element(0).n_dofs_per_cell());
+    pressure_dof.resize(fe.base_element(1).n_dofs_per_cell());
+    for (unsigned int k = 0; k < fe.n_dofs_per_cell(); ++k)
+    {
+      const auto [component, index] = fe.system_to_component_index(k);
+      if (component == 0)
+        velocity_dof[index] = k;
+      else if (component == dim)
+        pressure_dof[index] = k;
+    }
+  }
+
+
+  template <int dim>
+  bool
+  BoundaryFluxTerm<dim>::needed(const Geometry<dim> &geometry)
+  {
+    for (const BoundaryType type : geometry.boundary_types)
+      if (type == BoundaryType::open || type == BoundaryType::velocity)
+        return true;
+    return false;
+  }
+
+
+  template <int dim>
+  void
+  BoundaryFluxTerm<dim>::cell(const CellContext<dim> &context,
+                              CellIntegrals          &integrals) const
+  {
+    const auto &cell = context.cell;
+    for (const unsigned int face_no : cell->face_indices())
+    {
+      const auto face = cell->face(face_no);
+      if (!face->at_boundary())
+        continue;
+      const BoundaryType type = geometry.boundary_types[face->boundary_id()];
+      if (type != BoundaryType::open && type != BoundaryType::velocity)
+        continue;
+      fe_face_values.reinit(cell, face_no);
+      mixture_fields.evaluate(cell,
+                              fe_face_values.get_quadrature_points(),
+                              reference_points[face_no],
+                              time,
+                              mixture);
+      for (unsigned int q = 0; q < quadrature.size(); ++q)
+      {
+        const auto  &n       = fe_face_values.normal_vector(q);
+        const double JxW     = fe_face_values.JxW(q);
+        const double outflux = mixture.solid_flux[q] * n;
+        const double p_open =
+          type == BoundaryType::open ?
+            open_pressure.value(fe_face_values.quadrature_point(q)) :
+            0.0;
+        for (unsigned int a = 0; a < velocity_dof.size(); ++a)
+        {
+          const double N = fe_face_values.shape_value(velocity_dof[a], q);
+          for (unsigned int c = 0; c < dim; ++c)
+            integrals.rhs_u[a * dim + c] -=
+              (mixture.fluid_fraction[q] * p_open * (N * n[c])) * JxW;
+        }
+        for (unsigned int b = 0; b < pressure_dof.size(); ++b)
+          integrals.rhs_p[b] -=
+            (-fe_face_values.shape_value(pressure_dof[b], q) * outflux) * JxW;
+      }
+    }
+  }
+
+
+  template struct ScalarShapes<2>;
+  template struct ScalarShapes<3>;
+  template class AssemblyTerm<2>;
+  template class AssemblyTerm<3>;
+  template class TimeDerivativeTerm<2>;
+  template class TimeDerivativeTerm<3>;
+  template class DragFieldTerm<2>;
+  template class DragFieldTerm<3>;
+  template class ViscousTerm<2>;
+  template class ViscousTerm<3>;
+  template class AdvectionTerm<2>;
+  template class AdvectionTerm<3>;
+  template class ForcingTerm<2>;
+  template class ForcingTerm<3>;
+  template class PressureContinuityTerm<2>;
+  template class PressureContinuityTerm<3>;
+  template class GrainDragTerm<2>;
+  template class GrainDragTerm<3>;
+  template class BoundaryFluxTerm<2>;
+  template class BoundaryFluxTerm<3>;
+} // namespace ImmersedGrains
