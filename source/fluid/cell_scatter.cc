@@ -217,6 +217,14 @@ namespace ImmersedGrains
       }
     }
 
+    // Each local row's values in the two column blocks, looked up once
+    // per cell rather than once per entry.
+    row_pointers.resize(2 * dofs_per_cell);
+    for (unsigned int i = 0; i < dofs_per_cell; ++i)
+      for (unsigned int column_block = 0; column_block < 2; ++column_block)
+        row_pointers[2 * i + column_block] =
+          row_values[dof_block[i]][column_block][cell_rows[i]];
+
     for (std::size_t p = 0; p < pairs.size(); ++p)
     {
       if (cell_slots[p] == skip)
@@ -225,8 +233,7 @@ namespace ImmersedGrains
       double      value = cell_matrix(pair.i, pair.j);
       if (pair.i == pair.j && fixed[first_dof + pair.i])
         value = value != 0 ? std::abs(value) : mean_diagonal;
-      row_values[pair.row_block][pair.column_block][cell_rows[pair.i]]
-                [cell_slots[p]] += value;
+      row_pointers[2 * pair.i + pair.column_block][cell_slots[p]] += value;
     }
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       if (!fixed[first_dof + i])

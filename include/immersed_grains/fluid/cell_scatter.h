@@ -99,6 +99,8 @@ namespace ImmersedGrains
     // The values of each local row of each block, and of each vector block.
     std::array<std::array<std::vector<double *>, 2>, 2> row_values;
     std::array<double *, 2>                             vector_values{};
+    // The current cell's rows by local DoF and column block (add()).
+    mutable std::vector<double *> row_pointers;
   };
 } // namespace ImmersedGrains
 
