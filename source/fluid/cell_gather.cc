@@ -19,11 +19,14 @@ namespace ImmersedGrains
     for (unsigned int block = 0; block < 2; ++block)
       local_sizes[block] = vector.block(block).trilinos_vector().MyLength();
     positions.clear();
+    owned_number.assign(dof_handler.get_triangulation().n_active_cells(), -1);
+    int                                          owned = 0;
     std::vector<dealii::types::global_dof_index> indices(dofs_per_cell);
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
       if (!cell->is_locally_owned())
         continue;
+      owned_number[cell->active_cell_index()] = owned++;
       cell->get_dof_indices(indices);
       for (unsigned int i = 0; i < dofs_per_cell; ++i)
       {
@@ -64,6 +67,21 @@ namespace ImmersedGrains
     values.resize(dofs_per_cell);
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       values[i] = data[dof_block[i]][lid[i]];
+  }
+
+
+  template <int dim>
+  bool
+  CellGather<dim>::gather(
+    const typename dealii::DoFHandler<dim>::active_cell_iterator &cell,
+    const VectorType                                             &vector,
+    std::vector<double>                                          &values) const
+  {
+    const unsigned int index = cell->active_cell_index();
+    if (index >= owned_number.size() || owned_number[index] < 0)
+      return false;
+    gather(owned_number[index], vector, values);
+    return true;
   }
 
 

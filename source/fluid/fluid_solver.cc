@@ -171,8 +171,17 @@ namespace ImmersedGrains
   {
     const typename dealii::DoFHandler<dim>::active_cell_iterator cell(
       &triangulation, tria_cell->level(), tria_cell->index(), &dof_handler);
-    std::vector<dealii::types::global_dof_index> indices(fe.n_dofs_per_cell());
-    cell->get_dof_indices(indices);
+    // The cell's coefficients, read once (each read through the global
+    // index is a look-up in Epetra's map).
+    std::vector<double> local(fe.n_dofs_per_cell());
+    if (!cell_gather->gather(cell, solution, local))
+    {
+      std::vector<dealii::types::global_dof_index> indices(
+        fe.n_dofs_per_cell());
+      cell->get_dof_indices(indices);
+      for (unsigned int i = 0; i < indices.size(); ++i)
+        local[i] = solution(indices[i]);
+    }
     // The scalar Q2 (velocity) and Q1 (pressure) functions at the points:
     // one pass over each, no FEValues set up per call.
     velocity_shapes.reinit(cell, reference_locations, false);
@@ -180,7 +189,7 @@ namespace ImmersedGrains
     std::vector<PointValues> values(reference_locations.size());
     for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
     {
-      const double coefficient      = solution(indices[i]);
+      const double coefficient      = local[i];
       const auto [component, index] = fe.system_to_component_index(i);
       for (unsigned int q = 0; q < values.size(); ++q)
         if (component < dim)
@@ -206,8 +215,7 @@ namespace ImmersedGrains
         {
           const auto [component, index] = fe.system_to_component_index(i);
           if (component < dim)
-            mean[component] +=
-              solution(indices[i]) * mean_shapes.value(index, q) * JxW;
+            mean[component] += local[i] * mean_shapes.value(index, q) * JxW;
         }
       }
       for (auto &v : values)

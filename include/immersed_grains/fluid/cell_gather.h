@@ -37,6 +37,13 @@ namespace ImmersedGrains
            const VectorType    &vector,
            std::vector<double> &values) const;
 
+    /** The same for @p cell; false (and @p values untouched) where the
+     * cell is not locally owned. */
+    bool
+    gather(const typename dealii::DoFHandler<dim>::active_cell_iterator &cell,
+           const VectorType                                             &vector,
+           std::vector<double> &values) const;
+
     /** Whether @p vector has the local layout given to reinit(). */
     bool
     matches(const VectorType &vector) const;
@@ -44,8 +51,9 @@ namespace ImmersedGrains
   private:
     unsigned int              dofs_per_cell = 0;
     std::array<int, 2>        local_sizes{{-1, -1}};
-    std::vector<unsigned int> dof_block; // local DoF -> block
-    std::vector<int>          positions; // per owned cell, per local DoF
+    std::vector<unsigned int> dof_block;    // local DoF -> block
+    std::vector<int>          positions;    // per owned cell, per local DoF
+    std::vector<int>          owned_number; // per active cell index: k, or -1
   };
 } // namespace ImmersedGrains
 
