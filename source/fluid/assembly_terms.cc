@@ -19,6 +19,22 @@ namespace ImmersedGrains
   }
 
 
+  template <int dim>
+  ScalarDofs<dim>::ScalarDofs(const dealii::FESystem<dim> &fe)
+      : velocity(fe.base_element(0).n_dofs_per_cell())
+      , pressure(fe.base_element(1).n_dofs_per_cell())
+  {
+    for (unsigned int k = 0; k < fe.n_dofs_per_cell(); ++k)
+    {
+      const auto [component, index] = fe.system_to_component_index(k);
+      if (component < dim)
+        velocity[index][component] = k;
+      else
+        pressure[index] = k;
+    }
+  }
+
+
   void
   CellIntegrals::resize(const unsigned int dim,
                         const unsigned int n_velocity,
@@ -247,21 +263,16 @@ namespace ImmersedGrains
   template <int dim>
   GrainDragTerm<dim>::GrainDragTerm(const PointDragSource<dim>  &source,
                                     const dealii::FESystem<dim> &fe,
+                                    const ScalarDofs<dim>       &dofs,
                                     const bool                   cell_averaged,
                                     double                      &max_beta)
       : source(source)
       , element(fe.base_element(0))
+      , dofs(dofs)
       , cell_averaged(cell_averaged)
       , max_beta(max_beta)
       , shape(element.n_dofs_per_cell())
   {
-    first_component_dof.resize(element.n_dofs_per_cell());
-    for (unsigned int k = 0; k < fe.n_dofs_per_cell(); ++k)
-    {
-      const auto [component, index] = fe.system_to_component_index(k);
-      if (component == 0)
-        first_component_dof[index] = k;
-    }
   }
 
 
@@ -291,7 +302,7 @@ namespace ImmersedGrains
         volume += fe_values.JxW(q);
         for (unsigned int a = 0; a < n_s; ++a)
           shape[a] +=
-            fe_values.shape_value(first_component_dof[a], q) * fe_values.JxW(q);
+            fe_values.shape_value(dofs.velocity[a][0], q) * fe_values.JxW(q);
       }
       for (unsigned int a = 0; a < n_s; ++a)
         shape[a] /= volume;
@@ -301,7 +312,6 @@ namespace ImmersedGrains
       {
         total.beta += drag.beta;
         total.velocity += drag.beta * drag.velocity;
-        max_beta = std::max(max_beta, drag.beta);
       }
       // total.velocity holds sum beta_i v_i.
       drags.assign(1, total);
@@ -316,7 +326,8 @@ namespace ImmersedGrains
       for (unsigned int a = 0; a < n_s; ++a)
         if (shape[a] != 0)
           for (unsigned int c = 0; c < dim; ++c)
-            u_at_grain[c] += context.velocity[a * dim + c] * shape[a];
+            u_at_grain[c] +=
+              (*context.local_solution)[dofs.velocity[a][c]] * shape[a];
       // The slip force beta (u - v); with the cell's grains summed,
       // sum beta_i u - sum beta_i v_i.
       const dealii::Tensor<1, dim> force =
@@ -344,6 +355,7 @@ namespace ImmersedGrains
   BoundaryFluxTerm<dim>::BoundaryFluxTerm(
     const dealii::Mapping<dim>  &mapping,
     const dealii::FESystem<dim> &fe,
+    const ScalarDofs<dim>       &dofs,
     const Geometry<dim>         &geometry,
     const MixtureFields<dim>    &mixture_fields,
     dealii::Function<dim>       &open_pressure,
@@ -359,6 +371,7 @@ namespace ImmersedGrains
                        dealii::update_values | dealii::update_normal_vectors |
                          dealii::update_quadrature_points |
                          dealii::update_JxW_values)
+      , dofs(dofs)
   {
     open_pressure.set_time(time);
     for (const unsigned int f : dealii::GeometryInfo<dim>::face_indices())
@@ -366,16 +379,6 @@ namespace ImmersedGrains
         dealii::QProjector<dim>::project_to_face(
           dealii::ReferenceCells::get_hypercube<dim>(), quadrature, f)
           .get_points());
-    velocity_dof.resize(fe.base_element(0).n_dofs_per_cell());
-    pressure_dof.resize(fe.base_element(1).n_dofs_per_cell());
-    for (unsigned int k = 0; k < fe.n_dofs_per_cell(); ++k)
-    {
-      const auto [component, index] = fe.system_to_component_index(k);
-      if (component == 0)
-        velocity_dof[index] = k;
-      else if (component == dim)
-        pressure_dof[index] = k;
-    }
   }
 
 
@@ -419,21 +422,23 @@ namespace ImmersedGrains
           type == BoundaryType::open ?
             open_pressure.value(fe_face_values.quadrature_point(q)) :
             0.0;
-        for (unsigned int a = 0; a < velocity_dof.size(); ++a)
+        for (unsigned int a = 0; a < dofs.velocity.size(); ++a)
         {
-          const double N = fe_face_values.shape_value(velocity_dof[a], q);
+          const double N = fe_face_values.shape_value(dofs.velocity[a][0], q);
           for (unsigned int c = 0; c < dim; ++c)
             integrals.rhs_u[a * dim + c] -=
               (mixture.fluid_fraction[q] * p_open * (N * n[c])) * JxW;
         }
-        for (unsigned int b = 0; b < pressure_dof.size(); ++b)
+        for (unsigned int b = 0; b < dofs.pressure.size(); ++b)
           integrals.rhs_p[b] -=
-            (-fe_face_values.shape_value(pressure_dof[b], q) * outflux) * JxW;
+            (-fe_face_values.shape_value(dofs.pressure[b], q) * outflux) * JxW;
       }
     }
   }
 
 
+  template struct ScalarDofs<2>;
+  template struct ScalarDofs<3>;
   template struct ScalarShapes<2>;
   template struct ScalarShapes<3>;
   template class AssemblyTerm<2>;

@@ -217,18 +217,11 @@ namespace ImmersedGrains
 
     // Local index of velocity component c of scalar Q2 function a, and of
     // pressure function b.
-    const unsigned int n_s = fe.base_element(0).n_dofs_per_cell();
-    const unsigned int n_p = fe.base_element(1).n_dofs_per_cell();
-    std::vector<std::array<unsigned int, dim>> velocity_dof(n_s);
-    std::vector<unsigned int>                  pressure_dof(n_p);
-    for (unsigned int k = 0; k < dofs_per_cell; ++k)
-    {
-      const auto [component, index] = fe.system_to_component_index(k);
-      if (component < dim)
-        velocity_dof[index][component] = k;
-      else
-        pressure_dof[index] = k;
-    }
+    const unsigned int    n_s = fe.base_element(0).n_dofs_per_cell();
+    const unsigned int    n_p = fe.base_element(1).n_dofs_per_cell();
+    const ScalarDofs<dim> dofs(fe);
+    const auto           &velocity_dof = dofs.velocity;
+    const auto           &pressure_dof = dofs.pressure;
 
     const double rho = parameters.density, mu = parameters.viscosity;
     const double inv_dt =
@@ -237,7 +230,7 @@ namespace ImmersedGrains
 
     double                 max_beta = 0;
     const AssemblyTermList terms =
-      make_assembly_terms(rho, mu, inv_dt, max_beta);
+      make_assembly_terms(dofs, rho, mu, inv_dt, max_beta);
     const bool convection            = terms.convects;
     const bool convection_derivative = terms.linearises_convection;
 
@@ -257,8 +250,8 @@ namespace ImmersedGrains
     std::vector<double> advection_weight(n_s);
     CellContext<dim>    context;
     context.fe_values             = &fe_values;
+    context.local_solution        = &local_solution;
     context.preconditioner_pieces = assemble_preconditioner_matrices;
-    context.velocity.resize(n_s * dim);
 
     std::vector<dealii::Vector<double>> f(n_q, dealii::Vector<double>(dim));
     MixtureValues<dim>                  mixture;
@@ -470,10 +463,6 @@ namespace ImmersedGrains
       if (!terms.on_cells.empty())
       {
         context.cell = cell;
-        context.h    = h;
-        for (unsigned int a = 0; a < n_s; ++a)
-          for (unsigned int c = 0; c < dim; ++c)
-            context.velocity[a * dim + c] = local_solution[velocity_dof[a][c]];
         for (const auto *term : terms.on_cells)
           term->cell(context, integrals);
       }
@@ -507,14 +496,14 @@ namespace ImmersedGrains
             integrals.C[b * n_p + e];
       }
 
-      if (cell_scatter->is_direct(cell_number))
+      const bool direct = cell_scatter->is_direct(cell_number);
+      if (!direct || assemble_preconditioner_matrices)
+        cell->get_dof_indices(dof_indices);
+      if (direct)
         cell_scatter->add(cell_number, cell_matrix, cell_rhs);
       else
-      {
-        cell->get_dof_indices(dof_indices);
         update_constraints.distribute_local_to_global(
           cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
-      }
       if (assemble_preconditioner_matrices)
       {
         cell_mass     = 0;
@@ -529,7 +518,6 @@ namespace ImmersedGrains
         if (cell_drag > 0)
           cell_mass *=
             drag_cell_mass_factor(cell_drag * h * h / cell_viscosity);
-        cell->get_dof_indices(dof_indices);
         pressure_mass_constraints.distribute_local_to_global(
           cell_mass, dof_indices, pressure_mass_matrix);
         update_constraints.distribute_local_to_global(cell_reaction,
@@ -556,10 +544,11 @@ namespace ImmersedGrains
 
   template <int dim>
   typename FluidSolver<dim>::AssemblyTermList
-  FluidSolver<dim>::make_assembly_terms(const double rho,
-                                        const double mu,
-                                        const double inv_dt,
-                                        double      &max_beta) const
+  FluidSolver<dim>::make_assembly_terms(const ScalarDofs<dim> &dofs,
+                                        const double           rho,
+                                        const double           mu,
+                                        const double           inv_dt,
+                                        double                &max_beta) const
   {
     AssemblyTermList list;
     const auto       add =
@@ -585,12 +574,13 @@ namespace ImmersedGrains
     add(std::make_unique<ViscousTerm<dim>>(mu), true);
     if (point_drag_source)
       add(std::make_unique<GrainDragTerm<dim>>(
-            *point_drag_source, fe, cell_averaged_drag, max_beta),
+            *point_drag_source, fe, dofs, cell_averaged_drag, max_beta),
           false);
     if (BoundaryFluxTerm<dim>::needed(geometry))
       add(std::make_unique<BoundaryFluxTerm<dim>>(
             mapping,
             fe,
+            dofs,
             geometry,
             *mixture_fields,
             *parameters.open_boundary_pressure,
@@ -605,7 +595,15 @@ namespace ImmersedGrains
   template void
   FluidSolver<3>::assemble_system(bool);
   template FluidSolver<2>::AssemblyTermList
-  FluidSolver<2>::make_assembly_terms(double, double, double, double &) const;
+  FluidSolver<2>::make_assembly_terms(const ScalarDofs<2> &,
+                                      double,
+                                      double,
+                                      double,
+                                      double &) const;
   template FluidSolver<3>::AssemblyTermList
-  FluidSolver<3>::make_assembly_terms(double, double, double, double &) const;
+  FluidSolver<3>::make_assembly_terms(const ScalarDofs<3> &,
+                                      double,
+                                      double,
+                                      double,
+                                      double &) const;
 } // namespace ImmersedGrains

@@ -37,6 +37,21 @@ namespace ImmersedGrains
   };
 
 
+  /**
+   * The local index of each Taylor-Hood shape function by scalar function:
+   * velocity[a][c] for component c of Q2 function a, pressure[b] for Q1
+   * function b.
+   */
+  template <int dim>
+  struct ScalarDofs
+  {
+    explicit ScalarDofs(const dealii::FESystem<dim> &fe);
+
+    std::vector<std::array<unsigned int, dim>> velocity;
+    std::vector<unsigned int>                  pressure;
+  };
+
+
   /** The discrete solution and the mixture at one quadrature point. */
   template <int dim>
   struct PointState
@@ -116,11 +131,9 @@ namespace ImmersedGrains
   {
     typename dealii::Triangulation<dim>::active_cell_iterator cell;
     const dealii::FEValues<dim> *fe_values = nullptr;
-    double                       h         = 0;
-    // The current iterate's velocity coefficients by scalar function and
-    // component: velocity[a * dim + c].
-    std::vector<double> velocity;
-    bool                preconditioner_pieces = false;
+    // The current iterate's coefficients on the cell (local numbering).
+    const std::vector<double> *local_solution        = nullptr;
+    bool                       preconditioner_pieces = false;
   };
 
 
@@ -282,18 +295,18 @@ namespace ImmersedGrains
   public:
     GrainDragTerm(const PointDragSource<dim>  &source,
                   const dealii::FESystem<dim> &fe,
+                  const ScalarDofs<dim>       &dofs,
                   bool                         cell_averaged,
                   double                      &max_beta);
     void
     cell(const CellContext<dim> &, CellIntegrals &) const override;
 
   private:
-    const PointDragSource<dim>       &source;
-    const dealii::FiniteElement<dim> &element;
-    const bool                        cell_averaged;
-    double                           &max_beta;
-    // The system index of component 0 of each scalar function.
-    std::vector<unsigned int>           first_component_dof;
+    const PointDragSource<dim>         &source;
+    const dealii::FiniteElement<dim>   &element;
+    const ScalarDofs<dim>              &dofs;
+    const bool                          cell_averaged;
+    double                             &max_beta;
     mutable std::vector<PointDrag<dim>> drags;
     mutable std::vector<double>         shape;
   };
@@ -309,6 +322,7 @@ namespace ImmersedGrains
   public:
     BoundaryFluxTerm(const dealii::Mapping<dim>  &mapping,
                      const dealii::FESystem<dim> &fe,
+                     const ScalarDofs<dim>       &dofs,
                      const Geometry<dim>         &geometry,
                      const MixtureFields<dim>    &mixture_fields,
                      dealii::Function<dim>       &open_pressure,
@@ -328,7 +342,7 @@ namespace ImmersedGrains
     const dealii::QGauss<dim - 1>                quadrature;
     mutable dealii::FEFaceValues<dim>            fe_face_values;
     std::vector<std::vector<dealii::Point<dim>>> reference_points;
-    std::vector<unsigned int>                    velocity_dof, pressure_dof;
+    const ScalarDofs<dim>                       &dofs;
     mutable MixtureValues<dim>                   mixture;
   };
 } // namespace ImmersedGrains

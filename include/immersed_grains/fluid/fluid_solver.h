@@ -31,6 +31,8 @@ namespace ImmersedGrains
   class CellGather;
   template <int dim>
   class AssemblyTerm;
+  template <int dim>
+  struct ScalarDofs;
 
   /**
    * The volume-averaged (VANS) fluid: interstitial velocity u and pressure p
@@ -199,10 +201,11 @@ namespace ImmersedGrains
       bool forcing                                             = false;
     };
     AssemblyTermList
-    make_assembly_terms(double  density,
-                        double  viscosity,
-                        double  inv_dt,
-                        double &max_beta) const;
+    make_assembly_terms(const ScalarDofs<dim> &dofs,
+                        double                 density,
+                        double                 viscosity,
+                        double                 inv_dt,
+                        double                &max_beta) const;
 
     // Solves for newton_update; with @p fresh_preconditioner the
     // preconditioner is built first (its matrices must have been
