@@ -156,6 +156,18 @@ namespace ImmersedGrains
       "With Adaptive time step: the largest fraction of the shortest cell "
       "edge that grains (and, with advection, the fluid) cross in one fluid "
       "step (doc/performance.md measures the error against cost).");
+    prm.declare_entry(
+      "Divergence speed factor",
+      "100",
+      Double(0),
+      "A run stops with a message, after a last output, when a fluid or "
+      "grain speed exceeds this many times the fastest motion the scene "
+      "drives: free fall across the box along gravity, the boundary and "
+      "initial velocities, a prescribed grain velocity, and the speeds a "
+      "body force or an open-face pressure reaches across the box "
+      "(doc/stability.md). Such a run is exploding without being NaN yet, "
+      "and its adaptive steps shrink towards zero. 0 switches the check "
+      "off.");
 
     prm.enter_subsection("Output");
     {
@@ -257,8 +269,9 @@ namespace ImmersedGrains
                 "Time step",
                 prm.get("Time step"),
                 "must be positive");
-    adaptive_time_step = prm.get_bool("Adaptive time step");
-    courant_number     = prm.get_double("Courant number");
+    adaptive_time_step      = prm.get_bool("Adaptive time step");
+    courant_number          = prm.get_double("Courant number");
+    divergence_speed_factor = prm.get_double("Divergence speed factor");
     top.require(courant_number > 0 || !adaptive_time_step,
                 "Courant number",
                 prm.get("Courant number"),
@@ -854,8 +867,9 @@ namespace ImmersedGrains
     {
       prepare_output_directory(resumed_step);
       setup(resume_from);
-      start_time         = time;
-      last_progress_wall = now();
+      start_time          = time;
+      initial_grain_speed = grains ? grains->max_speed() : 0.0;
+      last_progress_wall  = now();
       if (resume_from.empty())
       {
         postprocess(0, 0);
@@ -872,6 +886,7 @@ namespace ImmersedGrains
         in_step = true;
         solve_time_step(dt);
         stop_if_not_finite();
+        stop_if_speeding();
         in_step = false;
         maybe_write_fields(time >= end_time * (1 - 1e-12));
         record_timings();
@@ -917,6 +932,13 @@ namespace ImmersedGrains
       print_test_checks(std::cout, test_checks, statistics);
 
     print_progress(true);
+    if (largest_speed_ratio > 0)
+      pdetail << "  divergence check: the fastest speed was "
+              << std::setprecision(3) << largest_speed_ratio
+              << " times the fastest motion the scene drives ("
+              << driven_at_largest << " m/s then); a run stops at "
+              << divergence_speed_factor << " times\n"
+              << std::setprecision(6);
     if (capped_contact_steps > 0)
       pcout << "  note: the contact solver stopped at Contacts/Max "
             << "iterations in " << capped_contact_steps << " step"
@@ -1416,15 +1438,128 @@ namespace ImmersedGrains
       dealii::Utilities::MPI::broadcast(comm,
                                         text.str(),
                                         teller == n_ranks ? 0 : teller);
+    stop_run(place +
+             " is not finite (NaN or Inf); the run diverged there. The last "
+             "output (step " +
+             std::to_string(step) +
+             ") holds it; a shorter Time step, or Adaptive time step = "
+             "true, usually keeps it finite.");
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::stop_run(const std::string &what)
+  {
     maybe_write_fields(true);
     std::ostringstream message;
-    message << "step " << step << " (t = " << time << " s): " << place
-            << " is not finite (NaN or Inf); the run diverged there. The last "
-               "output (step "
-            << step
-            << ") holds it; a shorter Time step, or Adaptive time step = "
-               "true, usually keeps it finite.";
+    message << "step " << step << " (t = " << time << " s): " << what;
     throw std::runtime_error(message.str());
+  }
+
+
+  template <int dim>
+  double
+  Simulation<dim>::driven_speed() const
+  {
+    const auto  &g    = grain_parameters.gravity;
+    double       drop = 0; // the box's extent along gravity
+    const double norm = g.norm();
+    for (unsigned int d = 0; d < dim && norm > 0; ++d)
+      drop += std::abs(g[d]) / norm *
+              (geometry.upper_corner[d] - geometry.lower_corner[d]);
+    return std::max({std::sqrt(2 * norm * drop),
+                     initial_grain_speed,
+                     fluid ? fluid->driven_speed() : 0.0});
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::stop_if_speeding()
+  {
+    if (divergence_speed_factor <= 0)
+      return;
+    const double fluid_speed = fluid ? fluid->max_velocity() : 0.0;
+    const double grain_speed = grains ? statistics.get("max_speed") : 0.0;
+    const double speed       = std::max(fluid_speed, grain_speed);
+    if (speed == 0)
+      return;
+    const double driven = driven_speed();
+    // Nothing drives any motion: there is no scale to compare with.
+    if (driven <= 0)
+      return;
+    if (speed / driven > largest_speed_ratio)
+    {
+      largest_speed_ratio = speed / driven;
+      driven_at_largest   = driven;
+    }
+    if (speed <= divergence_speed_factor * driven)
+      return;
+
+    // Where: the cell of the fastest fluid node, or the fastest grain.
+    double             local_max = 0;
+    dealii::Point<dim> where;
+    const bool         in_fluid = fluid_speed >= grain_speed;
+    if (in_fluid)
+    {
+      const auto &dof_handler = fluid->get_dof_handler();
+      const auto &solution    = fluid->get_solution();
+      const auto &fe          = dof_handler.get_fe();
+      std::vector<dealii::types::global_dof_index> indices(
+        fe.n_dofs_per_cell());
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(indices);
+          for (unsigned int i = 0; i < indices.size(); ++i)
+            if (fe.system_to_component_index(i).first < dim &&
+                std::abs(solution[indices[i]]) > local_max)
+            {
+              local_max = std::abs(solution[indices[i]]);
+              where     = cell->center();
+            }
+        }
+    }
+    else
+    {
+      const unsigned int velocity = grains->layout().velocity;
+      for (const auto &p : grains->particle_handler())
+      {
+        dealii::Tensor<1, dim> v;
+        for (unsigned int d = 0; d < dim; ++d)
+          v[d] = p.get_properties()[velocity + d];
+        if (v.norm() > local_max)
+        {
+          local_max = v.norm();
+          where     = p.get_location();
+        }
+      }
+    }
+    // The rank that holds the maximum tells (the lowest on a tie).
+    const unsigned int rank   = dealii::Utilities::MPI::this_mpi_process(comm);
+    const double global_max   = dealii::Utilities::MPI::max(local_max, comm);
+    const unsigned int teller = dealii::Utilities::MPI::min(
+      local_max == global_max ? rank :
+                                dealii::Utilities::MPI::n_mpi_processes(comm),
+      comm);
+    where = dealii::Utilities::MPI::broadcast(comm, where, teller);
+
+    std::ostringstream text;
+    text << std::setprecision(3) << "the " << (in_fluid ? "fluid" : "grains")
+         << " speed reached " << speed << " m/s near (";
+    for (unsigned int d = 0; d < dim; ++d)
+      text << (d > 0 ? ", " : "") << where[d];
+    text << "), over " << divergence_speed_factor
+         << " times the fastest motion the scene drives (" << driven
+         << " m/s: free fall across the box, boundary, initial and "
+            "prescribed velocities, forcing); the run is exploding. The last "
+            "output (step "
+         << step
+         << ") holds it. The usual causes: cells too coarse for the flow "
+            "(its cell Reynolds number), a step too long (Courant number, "
+            "Time step). Divergence speed factor sets the bound (0: off).";
+    stop_run(text.str());
   }
 
 

@@ -126,6 +126,21 @@ namespace ImmersedGrains
      *  after a last output. */
     void
     stop_if_not_finite();
+    /** Stops the run (collective), as stop_if_not_finite(), where a fluid
+     *  or grain speed exceeds Divergence speed factor times the fastest
+     *  motion the scene drives (driven_speed()): an exploding run that
+     *  has not reached NaN yet, whose steps may have shrunk to nothing. */
+    void
+    stop_if_speeding();
+    /** The fastest motion the scene's data drive (collective): free fall
+     *  across the box along gravity, the grains' initial speeds and what
+     *  FluidSolver::driven_speed() counts for the fluid. */
+    double
+    driven_speed() const;
+    // Stops the run after a last output of the step: "step N (t = T s): "
+    // and @p what.
+    [[noreturn]] void
+    stop_run(const std::string &what);
     /** The progress line, at most every Progress every seconds (a quarter
      *  of a second on a terminal); @p last: the run's last one. */
     void
@@ -139,11 +154,16 @@ namespace ImmersedGrains
     MPI_Comm    comm;
     std::string parameter_file;
     std::string output_directory;
-    double      end_time           = 1;
-    double      time_step          = 1;
-    bool        adaptive_time_step = false;
-    double      courant_number     = 0.1;
-    double      shortest_cell_edge = 0;
+    double      end_time                = 1;
+    double      time_step               = 1;
+    bool        adaptive_time_step      = false;
+    double      courant_number          = 0.1;
+    double      shortest_cell_edge      = 0;
+    double      divergence_speed_factor = 100;
+    double      initial_grain_speed     = 0;
+    // The largest speed over the driven speed so far, and that speed then.
+    double largest_speed_ratio = 0;
+    double driven_at_largest   = 0;
 
     unsigned int                    write_fields_every = 0;
     OutputFormat                    output_format      = OutputFormat::vtu;

@@ -307,7 +307,17 @@ namespace ImmersedGrains
         ++averaged_cells;
       }
       if (terms.forcing)
+      {
         forcing->vector_value_list(fe_values.get_quadrature_points(), f);
+        for (unsigned int q = 0; q < n_q; ++q)
+          max_forcing = std::max(max_forcing, f[q].l2_norm());
+      }
+      if (fields_prescribed)
+        for (unsigned int q = 0; q < n_q; ++q)
+          if (mixture.drag_coefficient[q] > 0)
+            max_prescribed_grain_speed =
+              std::max(max_prescribed_grain_speed,
+                       mixture.grain_velocity[q].norm());
 
       for (unsigned int q = 0; q < n_q; ++q)
       {

@@ -148,7 +148,8 @@ namespace ImmersedGrains
   FluidSolver<dim>::set_mixture_fields(
     std::shared_ptr<const MixtureFields<dim>> fields)
   {
-    mixture_fields = fields;
+    mixture_fields    = fields;
+    fields_prescribed = false;
   }
 
 
@@ -419,6 +420,10 @@ namespace ImmersedGrains
         dealii::VectorTools::compute_no_normal_flux_constraints(
           dof_handler, 0, slip_faces, c, mapping);
       c.close();
+      if (!homogeneous)
+        for (const auto &line : c.get_lines())
+          max_boundary_speed =
+            std::max(max_boundary_speed, std::abs(line.inhomogeneity));
     }
 
     // The pressure mass matrix only needs the constraints that tie pressure
@@ -447,11 +452,12 @@ namespace ImmersedGrains
                                        *parameters.initial_velocity),
                                      owned);
     solution_constraints.distribute(owned);
-    solution         = owned;
-    old_solution     = solution;
-    old_old_solution = solution;
-    time             = 0;
-    steps_done       = 0;
+    solution          = owned;
+    old_solution      = solution;
+    old_old_solution  = solution;
+    time              = 0;
+    steps_done        = 0;
+    max_initial_speed = owned.block(0).linfty_norm();
   }
 
 
@@ -593,6 +599,8 @@ namespace ImmersedGrains
 
     old_old_solution = old_solution;
     old_solution     = solution;
+    if (geometry.has_open_boundary())
+      sample_open_pressure();
 
     // Start from the extrapolated state and the new boundary data (only
     // velocity faces carry data that depends on time).
@@ -853,6 +861,46 @@ namespace ImmersedGrains
   FluidSolver<dim>::max_velocity() const
   {
     return solution.block(0).linfty_norm();
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::driven_speed() const
+  {
+    const MPI_Comm comm = mpi_communicator;
+    const double   L    = geometry.lower_corner.distance(geometry.upper_corner);
+    const double   rho = parameters.density, mu = parameters.viscosity;
+    const double   F = dealii::Utilities::MPI::max(max_forcing, comm);
+    const double   P = dealii::Utilities::MPI::max(max_open_pressure, comm);
+    const double   speeds[] = {
+        max_initial_speed,
+        dealii::Utilities::MPI::max(max_boundary_speed, comm),
+        dealii::Utilities::MPI::max(max_prescribed_grain_speed, comm),
+        std::sqrt(F * L / rho),
+        F * L * L / mu,
+        std::sqrt(2 * P / rho),
+        P * L / mu};
+    return *std::max_element(std::begin(speeds), std::end(speeds));
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::sample_open_pressure()
+  {
+    auto &pressure = *parameters.open_boundary_pressure;
+    pressure.set_time(time);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->at_boundary())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) &&
+              geometry.boundary_types[cell->face(f)->boundary_id()] ==
+                BoundaryType::open)
+            for (const unsigned int v : cell->face(f)->vertex_indices())
+              max_open_pressure =
+                std::max(max_open_pressure,
+                         std::abs(pressure.value(cell->face(f)->vertex(v))));
   }
 
 

@@ -167,6 +167,19 @@ namespace ImmersedGrains
     double
     max_velocity() const;
 
+    /**
+     * The fastest flow the fluid's data can drive (collective), for the
+     * divergence check of Simulation: the largest of the initial velocity,
+     * the boundary velocities, a prescribed grain velocity where its drag
+     * acts, and the speeds that the largest body force F and open-face
+     * pressure P seen so far reach across the box's diagonal L, inertial
+     * (sqrt(F L / rho), sqrt(2 P / rho)) or viscous (F L^2 / mu,
+     * P L / mu), whichever is larger. Gravity is the caller's: its
+     * hydrostatic part is in the pressure.
+     */
+    double
+    driven_speed() const;
+
     /** Integral of the fluid fraction over the mesh. */
     double
     integrate_fluid_fraction() const;
@@ -281,6 +294,20 @@ namespace ImmersedGrains
     // A forcing given as zeros: its term is left out of the assembly.
     bool                                   forcing_is_zero = false;
     std::shared_ptr<dealii::Function<dim>> boundary_velocity;
+
+    // What the data drive (driven_speed()): maxima on this rank since the
+    // start (of this process: a resumed run starts them afresh).
+    double max_initial_speed          = 0;
+    double max_boundary_speed         = 0;
+    double max_forcing                = 0; // |f|, N/m^3
+    double max_prescribed_grain_speed = 0; // where beta > 0, without grains
+    double max_open_pressure          = 0; // |p| on open faces, Pa
+    // Whether the mixture fields are the prescribed functions, not grains'.
+    bool fields_prescribed = true;
+
+    // Samples the open-face pressure at the faces' vertices.
+    void
+    sample_open_pressure();
 
     double       time       = 0;
     double       dt         = 0;
