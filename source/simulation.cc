@@ -78,6 +78,8 @@ namespace ImmersedGrains
       for (const auto &name : dim == 2 ? CloudAnalysis<2>::column_names() :
                                          CloudAnalysis<3>::column_names())
         c.push_back(name);
+      // Fluid steps taken again shorter after a failure, since the start.
+      c.emplace_back("step_retries");
       return c;
     }
 
@@ -156,6 +158,16 @@ namespace ImmersedGrains
       "With Adaptive time step: the largest fraction of the shortest cell "
       "edge that grains (and, with advection, the fluid) cross in one fluid "
       "step (doc/performance.md measures the error against cost).");
+    prm.declare_entry(
+      "Step retries",
+      "3",
+      Integer(0, 20),
+      "With Adaptive time step: a fluid step that fails (its linear or "
+      "nonlinear solve does not converge, or meets a value that is not "
+      "finite) is taken again from where it started with half the step, up "
+      "to this many times, before the run stops. The steps after a retry "
+      "grow back by at most a factor of 2 each. The statistics column "
+      "step_retries counts them.");
     prm.declare_entry(
       "Divergence speed factor",
       "100",
@@ -272,6 +284,7 @@ namespace ImmersedGrains
     adaptive_time_step      = prm.get_bool("Adaptive time step");
     courant_number          = prm.get_double("Courant number");
     divergence_speed_factor = prm.get_double("Divergence speed factor");
+    step_retries            = prm.get_integer("Step retries");
     top.require(courant_number > 0 || !adaptive_time_step,
                 "Courant number",
                 prm.get("Courant number"),
@@ -884,7 +897,7 @@ namespace ImmersedGrains
         const double dt = next_time_step();
         ++step;
         in_step = true;
-        solve_time_step(dt);
+        solve_time_step_or_retry(dt);
         stop_if_not_finite();
         stop_if_speeding();
         in_step = false;
@@ -908,13 +921,18 @@ namespace ImmersedGrains
         d->print_info(info);
         message = one_line(info.str());
       }
+      else if (dynamic_cast<const FluidStepFailure *>(&e) != nullptr)
+        message = one_line(e.what());
       if (in_step && serial && !message.empty())
       {
         try
         {
           maybe_write_fields(true);
           message += " The last output (step " + std::to_string(step) +
-                     ") holds the failed step.";
+                     ") holds " +
+                     (dynamic_cast<const FluidStepFailure *>(&e) != nullptr ?
+                        "the state the failed step started from." :
+                        "the failed step.");
         }
         catch (...)
         {
@@ -975,12 +993,52 @@ namespace ImmersedGrains
           dt = std::min(dt, courant_number * shortest_cell_edge / u);
       }
     }
+    // After a retry the step grows back by at most a factor of 2 per step.
+    if (adaptive_time_step && retried_step > 0)
+      dt = std::min(dt, 2 * retried_step);
     // An adaptive run does not end on a sliver: what is left of the run,
     // if less than two steps, is split into two equal ones.
     const double remaining = end_time - time;
     if (adaptive_time_step && remaining > dt * (1 + 1e-6) && remaining < 2 * dt)
       dt = remaining / 2;
     return std::min(dt, remaining);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::solve_time_step_or_retry(const double dt)
+  {
+    double step_length = dt;
+    for (unsigned int retry = 0;; ++retry)
+    {
+      try
+      {
+        solve_time_step(step_length);
+        break;
+      }
+      catch (const FluidStepFailure &failure)
+      {
+        // Every rank fails together: the solvers' decisions rest on
+        // global norms.
+        if (!adaptive_time_step || retry == step_retries)
+          throw;
+        std::ostringstream warning;
+        warning << "  warning: step " << step << ": "
+                << one_line(failure.what())
+                << " Taken again with half the step, " << step_length / 2
+                << " s.\n";
+        pcout << warning.str();
+        step_length /= 2;
+        statistics.set("step_retries", statistics.get("step_retries") + 1);
+      }
+    }
+    // The cap on the next steps: grown by 2 per step from the step that
+    // passed, dropped once it no longer binds.
+    if (step_length < dt)
+      retried_step = step_length;
+    else if (retried_step > 0)
+      retried_step = 2 * retried_step >= time_step ? 0 : 2 * retried_step;
   }
 
 

@@ -126,6 +126,10 @@ namespace ImmersedGrains
      *  after a last output. */
     void
     stop_if_not_finite();
+    /** solve_time_step(), taken again with half the step where the fluid
+     *  step fails, up to Step retries times with Adaptive time step. */
+    void
+    solve_time_step_or_retry(double dt);
     /** Stops the run (collective), as stop_if_not_finite(), where a fluid
      *  or grain speed exceeds Divergence speed factor times the fastest
      *  motion the scene drives (driven_speed()): an exploding run that
@@ -151,16 +155,20 @@ namespace ImmersedGrains
     void
     record_timings();
 
-    MPI_Comm    comm;
-    std::string parameter_file;
-    std::string output_directory;
-    double      end_time                = 1;
-    double      time_step               = 1;
-    bool        adaptive_time_step      = false;
-    double      courant_number          = 0.1;
-    double      shortest_cell_edge      = 0;
-    double      divergence_speed_factor = 100;
-    double      initial_grain_speed     = 0;
+    MPI_Comm     comm;
+    std::string  parameter_file;
+    std::string  output_directory;
+    double       end_time                = 1;
+    double       time_step               = 1;
+    bool         adaptive_time_step      = false;
+    double       courant_number          = 0.1;
+    double       shortest_cell_edge      = 0;
+    double       divergence_speed_factor = 100;
+    double       initial_grain_speed     = 0;
+    unsigned int step_retries            = 3;
+    // The step that passed after the last retry, doubled each step while
+    // it caps the adaptive step (0: no cap).
+    double retried_step = 0;
     // The largest speed over the driven speed so far, and that speed then.
     double largest_speed_ratio = 0;
     double driven_at_largest   = 0;

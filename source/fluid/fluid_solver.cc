@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <cctype>
+#include <sstream>
 
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_renumbering.h>
@@ -580,6 +582,49 @@ namespace ImmersedGrains
   template <int dim>
   typename FluidSolver<dim>::StepStatistics
   FluidSolver<dim>::solve_time_step(const double new_time, const double step)
+  {
+    // What a failed step gives back: three vector copies, a small part of
+    // the step's cost, bought every step so that a failure can be retried.
+    const VectorType before = solution, old_before = old_solution,
+                     older_before = old_old_solution;
+    const double time_before = time, dt_before = dt, old_dt_before = old_dt;
+    const unsigned int steps_before = steps_done;
+    try
+    {
+      return advance(new_time, step);
+    }
+    catch (const std::exception &failure)
+    {
+      std::string what = failure.what();
+      if (const auto *e = dynamic_cast<const dealii::ExceptionBase *>(&failure))
+      {
+        std::ostringstream info;
+        e->print_info(info);
+        what = info.str();
+        while (!what.empty() && std::isspace(what.back()))
+          what.pop_back();
+      }
+      solution         = before;
+      old_solution     = old_before;
+      old_old_solution = older_before;
+      time             = time_before;
+      dt               = dt_before;
+      old_dt           = old_dt_before;
+      steps_done       = steps_before;
+      // Its preconditioner was built for the failed step.
+      rebuild_requested = true;
+      if (std::find(geometry.boundary_types.begin(),
+                    geometry.boundary_types.end(),
+                    BoundaryType::velocity) != geometry.boundary_types.end())
+        make_constraints();
+      throw FluidStepFailure(what);
+    }
+  }
+
+
+  template <int dim>
+  typename FluidSolver<dim>::StepStatistics
+  FluidSolver<dim>::advance(const double new_time, const double step)
   {
     old_dt = dt;
     dt     = step;

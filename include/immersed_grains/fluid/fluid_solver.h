@@ -21,6 +21,7 @@
 #include <immersed_grains/mesh/geometry.h>
 
 #include <memory>
+#include <stdexcept>
 
 namespace ImmersedGrains
 {
@@ -33,6 +34,17 @@ namespace ImmersedGrains
   class AssemblyTerm;
   template <int dim>
   struct ScalarDofs;
+
+  /**
+   * A fluid step that failed (its linear or nonlinear solve did not
+   * converge, or met a value that is not finite); the solver is back in
+   * the state before the step, so that the caller may try a shorter one.
+   */
+  class FluidStepFailure : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
 
   /**
    * The volume-averaged (VANS) fluid: interstitial velocity u and pressure p
@@ -146,7 +158,9 @@ namespace ImmersedGrains
       unsigned int preconditioner_builds = 0;
     };
 
-    /** Advances from the current time to @p new_time = time + dt. */
+    /** Advances from the current time to @p new_time = time + dt. A step
+     *  that fails throws FluidStepFailure and leaves the solver as it was
+     *  before it. */
     StepStatistics
     solve_time_step(double new_time, double dt);
 
@@ -197,6 +211,10 @@ namespace ImmersedGrains
     get_time() const;
 
   private:
+    // solve_time_step() without the way back.
+    StepStatistics
+    advance(double new_time, double dt);
+
     void
     make_constraints();
 
