@@ -1434,27 +1434,16 @@ namespace ImmersedGrains
     dealii::Point<dim> where;
     bool               found = false;
     if (!fluid_finite)
-    {
-      const auto &dof_handler = fluid->get_dof_handler();
-      const auto &solution    = fluid->get_solution();
-      const auto &fe          = dof_handler.get_fe();
-      std::vector<dealii::types::global_dof_index> indices(
-        fe.n_dofs_per_cell());
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (!found && cell->is_locally_owned())
+      visit_fluid_values(
+        [&](const dealii::Point<dim> &centre, const bool velocity, double value)
         {
-          cell->get_dof_indices(indices);
-          for (unsigned int i = 0; i < indices.size() && !found; ++i)
-            if (!std::isfinite(solution[indices[i]]))
-            {
-              found = true;
-              where = cell->center();
-              field = fe.system_to_component_index(i).first < dim ?
-                        "fluid velocity" :
-                        "fluid pressure";
-            }
-        }
-    }
+          if (std::isfinite(value))
+            return false;
+          found = true;
+          where = centre;
+          field = velocity ? "fluid velocity" : "fluid pressure";
+          return true;
+        });
     if (!found && grains)
     {
       const unsigned int velocity = grains->layout().velocity;
@@ -1502,6 +1491,30 @@ namespace ImmersedGrains
              std::to_string(step) +
              ") holds it; a shorter Time step, or Adaptive time step = "
              "true, usually keeps it finite.");
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::visit_fluid_values(
+    const std::function<bool(const dealii::Point<dim> &, bool, double)> &visit)
+    const
+  {
+    const auto &dof_handler = fluid->get_dof_handler();
+    const auto &solution    = fluid->get_solution();
+    const auto &fe          = dof_handler.get_fe();
+    std::vector<dealii::types::global_dof_index> indices(fe.n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        cell->get_dof_indices(indices);
+        const dealii::Point<dim> centre = cell->center();
+        for (unsigned int i = 0; i < indices.size(); ++i)
+          if (visit(centre,
+                    fe.system_to_component_index(i).first < dim,
+                    solution[indices[i]]))
+            return;
+      }
   }
 
 
@@ -1560,25 +1573,16 @@ namespace ImmersedGrains
     dealii::Point<dim> where;
     const bool         in_fluid = fluid_speed >= grain_speed;
     if (in_fluid)
-    {
-      const auto &dof_handler = fluid->get_dof_handler();
-      const auto &solution    = fluid->get_solution();
-      const auto &fe          = dof_handler.get_fe();
-      std::vector<dealii::types::global_dof_index> indices(
-        fe.n_dofs_per_cell());
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (cell->is_locally_owned())
+      visit_fluid_values(
+        [&](const dealii::Point<dim> &centre, const bool velocity, double value)
         {
-          cell->get_dof_indices(indices);
-          for (unsigned int i = 0; i < indices.size(); ++i)
-            if (fe.system_to_component_index(i).first < dim &&
-                std::abs(solution[indices[i]]) > local_max)
-            {
-              local_max = std::abs(solution[indices[i]]);
-              where     = cell->center();
-            }
-        }
-    }
+          if (velocity && std::abs(value) > local_max)
+          {
+            local_max = std::abs(value);
+            where     = centre;
+          }
+          return false;
+        });
     else
     {
       const unsigned int velocity = grains->layout().velocity;

@@ -141,6 +141,13 @@ namespace ImmersedGrains
      *  FluidSolver::driven_speed() counts for the fluid. */
     double
     driven_speed() const;
+    // Calls @p visit(cell centre, whether a velocity, value) for the fluid
+    // DoFs of each owned cell, in turn, until it returns true (the
+    // searches behind the messages above; failure paths only).
+    void
+    visit_fluid_values(
+      const std::function<bool(const dealii::Point<dim> &, bool, double)>
+        &visit) const;
     // Stops the run after a last output of the step: "step N (t = T s): "
     // and @p what.
     [[noreturn]] void

@@ -1,5 +1,5 @@
 #include <algorithm>
-#include <cctype>
+#include <array>
 #include <sstream>
 
 #include <deal.II/base/quadrature_lib.h>
@@ -17,6 +17,7 @@
 #include <immersed_grains/fluid/cell_gather.h>
 #include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/parameters.h>
 
 namespace ImmersedGrains
 {
@@ -600,9 +601,7 @@ namespace ImmersedGrains
       {
         std::ostringstream info;
         e->print_info(info);
-        what = info.str();
-        while (!what.empty() && std::isspace(what.back()))
-          what.pop_back();
+        what = one_line(info.str());
       }
       solution         = before;
       old_solution     = old_before;
@@ -913,19 +912,24 @@ namespace ImmersedGrains
   double
   FluidSolver<dim>::driven_speed() const
   {
-    const MPI_Comm comm = mpi_communicator;
-    const double   L    = geometry.lower_corner.distance(geometry.upper_corner);
-    const double   rho = parameters.density, mu = parameters.viscosity;
-    const double   F = dealii::Utilities::MPI::max(max_forcing, comm);
-    const double   P = dealii::Utilities::MPI::max(max_open_pressure, comm);
-    const double   speeds[] = {
-        max_initial_speed,
-        dealii::Utilities::MPI::max(max_boundary_speed, comm),
-        dealii::Utilities::MPI::max(max_prescribed_grain_speed, comm),
-        std::sqrt(F * L / rho),
-        F * L * L / mu,
-        std::sqrt(2 * P / rho),
-        P * L / mu};
+    // The rank-local maxima in one reduction.
+    std::array<double, 4> local = {{max_forcing,
+                                    max_open_pressure,
+                                    max_boundary_speed,
+                                    max_prescribed_grain_speed}};
+    dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local),
+                                mpi_communicator,
+                                dealii::ArrayView<double>(local));
+    const auto [F, P, boundary, prescribed] = local;
+    const double L   = geometry.lower_corner.distance(geometry.upper_corner);
+    const double rho = parameters.density, mu = parameters.viscosity;
+    const double speeds[] = {max_initial_speed,
+                             boundary,
+                             prescribed,
+                             std::sqrt(F * L / rho),
+                             F * L * L / mu,
+                             std::sqrt(2 * P / rho),
+                             P * L / mu};
     return *std::max_element(std::begin(speeds), std::end(speeds));
   }
 
