@@ -146,11 +146,14 @@ namespace ImmersedGrains
       "flow, at most Courant number times the shortest cell edge over the "
       "largest grain speed (the solid fraction moves by at most that part "
       "of a cell per fluid step) and, with advection, over the largest "
-      "fluid speed; the grains sub-step inside it so that none moves more "
-      "than Grains/Max displacement fraction of the smallest radius per "
-      "sub-step. Otherwise the whole step follows the grains: no grain "
-      "moves more than that fraction of the smallest radius, nor more than "
-      "half the shortest cell edge, in one step.");
+      "fluid speed; from rest, the step in which free fall (gravity less "
+      "buoyancy) crosses that part of a cell; the grains sub-step inside it "
+      "so that none moves more than Grains/Max displacement fraction of "
+      "the smallest radius per sub-step. Otherwise the whole step follows "
+      "the grains: no grain moves more than that fraction of the smallest "
+      "radius, nor more than half the shortest cell edge, in one step. "
+      "Either way a step is at most twice the last (variable-step BDF2 "
+      "is stable below 1 + sqrt 2).");
     prm.declare_entry(
       "Courant number",
       "0.1",
@@ -983,6 +986,12 @@ namespace ImmersedGrains
         const double v = grains->max_speed();
         if (v > 0)
           dt = std::min(dt, courant_number * h / v);
+        else if (const double g = buoyant_gravity(); g > 0)
+          // From rest the rule above sets no step, and the first one would
+          // be the whole Time step, however far the grains then fall in it.
+          // Free fall is the fastest they can start: the step in which it
+          // crosses the Courant number of a cell, 1/2 g dt^2 = C h.
+          dt = std::min(dt, std::sqrt(2 * courant_number * h / g));
       }
       else if (grains)
         dt = grains->stable_time_step(dt);
@@ -993,15 +1002,29 @@ namespace ImmersedGrains
           dt = std::min(dt, courant_number * shortest_cell_edge / u);
       }
     }
-    // After a retry the step grows back by at most a factor of 2 per step.
-    if (adaptive_time_step && retried_step > 0)
-      dt = std::min(dt, 2 * retried_step);
+    // A step grows by at most a factor of 2 over the last: variable-step
+    // BDF2 is zero-stable only below a ratio of 1 + sqrt(2), and its
+    // extrapolated start (1 + w) u^n - w u^{n-1} amplifies the last step's
+    // error by the ratio w. The same rule brings the step back after a
+    // retry.
+    if (adaptive_time_step && last_step > 0)
+      dt = std::min(dt, 2 * last_step);
     // An adaptive run does not end on a sliver: what is left of the run,
     // if less than two steps, is split into two equal ones.
     const double remaining = end_time - time;
     if (adaptive_time_step && remaining > dt * (1 + 1e-6) && remaining < 2 * dt)
       dt = remaining / 2;
     return std::min(dt, remaining);
+  }
+
+
+  template <int dim>
+  double
+  Simulation<dim>::buoyant_gravity() const
+  {
+    const double rho = fluid_parameters.enabled ? fluid_parameters.density : 0;
+    return grain_parameters.gravity.norm() *
+           std::abs(1 - rho / grain_parameters.density);
   }
 
 
@@ -1033,12 +1056,7 @@ namespace ImmersedGrains
         statistics.set("step_retries", statistics.get("step_retries") + 1);
       }
     }
-    // The cap on the next steps: grown by 2 per step from the step that
-    // passed, dropped once it no longer binds.
-    if (step_length < dt)
-      retried_step = step_length;
-    else if (retried_step > 0)
-      retried_step = 2 * retried_step >= time_step ? 0 : 2 * retried_step;
+    last_step = step_length;
   }
 
 

@@ -141,6 +141,12 @@ namespace ImmersedGrains
      *  FluidSolver::driven_speed() counts for the fluid. */
     double
     driven_speed() const;
+
+    /** The grains' gravity less their buoyancy, |g| |1 - rho/rho_p| (rho
+     *  the fluid's density, 0 without fluid): their acceleration from
+     *  rest before drag acts. */
+    double
+    buoyant_gravity() const;
     // Calls @p visit(cell centre, whether a velocity, value) for the fluid
     // DoFs of each owned cell, in turn, until it returns true (the
     // searches behind the messages above; failure paths only).
@@ -173,9 +179,9 @@ namespace ImmersedGrains
     double       divergence_speed_factor = 100;
     double       initial_grain_speed     = 0;
     unsigned int step_retries            = 3;
-    // The step that passed after the last retry, doubled each step while
-    // it caps the adaptive step (0: no cap).
-    double retried_step = 0;
+    // The length of the last step taken (0 before the first, and on
+    // resuming): an adaptive step grows by at most twice it.
+    double last_step = 0;
     // The largest speed over the driven speed so far, and that speed then.
     double largest_speed_ratio = 0;
     double driven_at_largest   = 0;
