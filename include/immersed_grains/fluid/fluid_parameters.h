@@ -80,7 +80,7 @@ namespace ImmersedGrains
     // With `auto`, the ILU is chosen below this viscous number.
     double       velocity_ilu_threshold       = 1;
     unsigned int velocity_ilu_sweeps          = 1;
-    unsigned int velocity_amg_cycles          = 2;
+    unsigned int velocity_amg_cycles          = 1; // auto: 2 if steady
     unsigned int velocity_inner_iterations    = 0;
     double       velocity_inner_tolerance     = 1e-6;
     unsigned int pressure_mass_iterations     = 3;
