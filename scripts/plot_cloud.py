@@ -23,6 +23,11 @@ writes
   P_groups.png  with --groups N (N clouds placed one after another): each
                 cloud's fall velocity and the vertical distance between
                 consecutive clouds' centroids; the stages colour each.
+  P_front.png   2D: the maxima of the over-pressure ahead of the cloud
+  P_front.csv   against time, across the fall (doc/output.md, "The front
+                over-pressure"): one at the cloud's front while it is
+                whole, two once it has split; the first time two are seen
+                is printed.
 
 P defaults to OUTPUT_DIR/cloud. Needs the Cloud analysis columns (on by
 default for a ball of grains) and fields written at the chosen instants
@@ -171,11 +176,7 @@ def plot_flow(directory, stats, times, half_width, out):
     for axes, t in zip(np.atleast_1d(panels), times):
         t_state, pieces = nearest(fields, t)
         x, p, v = fields_at(pieces)
-        # The hydrostatic part: the least-squares plane of the pressure
-        # over the whole domain (the mixture's mean weight).
-        basis = np.column_stack([np.ones(len(x)), x[:, 0], x[:, 1]])
-        coefficients = np.linalg.lstsq(basis, p, rcond=None)[0]
-        excess = p - basis @ coefficients
+        excess = excess_pressure(x, p)
         centre = centroid_at(stats, t_state)
         triangulation = mtri.Triangulation(x[:, 0], x[:, 1])
         n = 120
@@ -276,6 +277,90 @@ def plot_groups(directory, stats, groups, out):
     print(out)
 
 
+def excess_pressure(x, p):
+    """The pressure less its hydrostatic part: the least-squares plane
+    through the whole domain (the mixture's mean weight)."""
+    basis = np.column_stack([np.ones(len(x)), x[:, 0], x[:, 1]])
+    return p - basis @ np.linalg.lstsq(basis, p, rcond=None)[0]
+
+
+def smoothed(grid, sigma):
+    """Gaussian smoothing of a 2D array, sigma in grid spacings; the
+    kernel is renormalised at the edges, so that a constant stays one."""
+    k = np.arange(-int(3 * sigma), int(3 * sigma) + 1)
+    w = np.exp(-0.5 * (k / sigma) ** 2)
+
+    def along(a, axis):
+        return np.apply_along_axis(lambda r: np.convolve(r, w, "same"),
+                                   axis, a)
+    ones = np.ones_like(grid)
+    return along(along(grid, 1), 0) / along(along(ones, 1), 0)
+
+
+def front_maxima(directory, stats, radius, out):
+    """Per written state: the maxima of the excess pressure, smoothed
+    over half the cloud's radius, along the row where it peaks within two
+    radii ahead of the cloud (below its centroid), those above half of
+    the row's range; x relative to the centroid, in cloud radii.
+    Smoothing over R/2: at cells of R/4 the pressure is grainy at the cell
+    scale, and unsmoothed rows flicker between one and two maxima (R/4
+    to R/2 smoothing give the same split within 0.1 s on the main scene,
+    doc/scenes/falling_cloud_2d.md)."""
+    fields = written_states(directory, "fields")
+    spacing = radius / 20
+    n = 121  # +-3 R
+    rows = []
+    for t, pieces in fields:
+        x, p, _ = fields_at(pieces)
+        excess = excess_pressure(x, p)
+        cx, cy = centroid_at(stats, t)
+        gx = cx + spacing * (np.arange(n) - n // 2)
+        gy = cy + spacing * (np.arange(n) - n // 2)
+        X, Y = np.meshgrid(gx, gy)
+        grid = mtri.LinearTriInterpolator(
+            mtri.Triangulation(x[:, 0], x[:, 1]), excess)(X, Y)
+        inside = ~np.ma.getmaskarray(grid)
+        field = smoothed(np.ma.filled(grid, 0.0), 10.0)
+        front = inside & (Y < cy) & (Y > cy - 2 * radius)
+        if not front.any():
+            continue
+        i = np.unravel_index(np.argmax(np.where(front, field, -np.inf)),
+                             field.shape)[0]
+        row, ok = field[i], inside[i]
+        valid = row[ok]
+        threshold = valid.min() + 0.5 * (valid.max() - valid.min())
+        maxima = [(gx[j] - cx) / radius for j in range(1, n - 1)
+                  if ok[j - 1] and ok[j] and ok[j + 1] and
+                  row[j] > row[j - 1] and row[j] >= row[j + 1] and
+                  row[j] > threshold]
+        rows.append((t, maxima))
+    with open(out + ".csv", "w") as f:
+        f.write("time,maxima,positions_over_R\n")
+        for t, maxima in rows:
+            f.write("%.6g,%d,%s\n" % (t, len(maxima),
+                                      " ".join("%.3f" % m for m in maxima)))
+    figure, axes = plt.subplots(figsize=(6, 3.4))
+    for t, maxima in rows:
+        axes.plot([t] * len(maxima), maxima, "k.", ms=3)
+    breakup = stats["breakup_time"][-1]
+    if breakup >= 0:
+        axes.axvline(breakup, color="r", lw=0.8, ls="--",
+                     label="break-up (clusters)")
+        axes.legend(fontsize=8)
+    axes.set_xlabel("t [s]")
+    axes.set_ylabel("front over-pressure maxima, (x - x_c) / R")
+    axes.grid(alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(out + ".png", dpi=150)
+    plt.close(figure)
+    split = next((t for t, maxima in rows if len(maxima) >= 2), None)
+    print(out + ".png")
+    print(out + ".csv")
+    print("front over-pressure: " +
+          ("two maxima first at t = %.3g s (written states)" % split
+           if split is not None else "one maximum throughout"))
+
+
 def times_option(text, count, name):
     if text is None:
         return None
@@ -320,6 +405,9 @@ def main():
     if VERTICAL == "y":
         plot_flow(args.directory, stats, flow, half_width,
                   prefix + "_flow.png")
+        # A uniform disc's radius of gyration per axis is half its radius.
+        front_maxima(args.directory, stats, 2 * stats["cloud_extent_x"][0],
+                     prefix + "_front")
     else:
         print("(no flow figure in 3D: open fields.pvd in ParaView)")
     plot_series(stats, prefix + "_series.png", args.reference_velocity)
