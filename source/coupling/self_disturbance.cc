@@ -82,6 +82,16 @@ namespace ImmersedGrains
 
   template <int dim>
   double
+  SelfDisturbance<dim>::structure_factor(const double s)
+  {
+    const double solid = std::clamp(s, 0.0, 1.0);
+    return dim == 3 ? std::pow(1 - solid, 4) / std::pow(1 + 2 * solid, 2) :
+                      std::pow(1 - solid, 3) / (1 + solid);
+  }
+
+
+  template <int dim>
+  double
   SelfDisturbance<dim>::build_up_time(const double h,
                                       const double kinematic_viscosity) const
   {

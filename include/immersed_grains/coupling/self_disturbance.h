@@ -33,6 +33,13 @@ namespace ImmersedGrains
    * fitted to a run (benchmarks/self_disturbance/ reproduces the
    * integrals and compares them with measured lone grains).
    *
+   * Among other grains both parts are smaller: no other grain's centre
+   * comes closer than a diameter, and the hole this leaves around the
+   * grain takes out of the fields it reads a share of what the grain puts
+   * in, the more so the denser the packing. For kernels wider than a
+   * grain the share that stays is the static structure factor at zero
+   * wave number, structure_factor() (doc/theory.md).
+   *
    * The disturbance needs time to build up: a fluid with a time
    * derivative reaches K f over the kernel's diffusion time t_K =
    * build_up_time(), and a grain that slips through the fluid leaves its
@@ -67,6 +74,14 @@ namespace ImmersedGrains
      *  (benchmarks/self_disturbance/kernel_integrals.py). */
     double
     build_up_time(double h, double kinematic_viscosity) const;
+
+    /** S(0) of hard spheres (3D, Percus-Yevick: (1 - s)^4 / (1 + 2 s)^2)
+     *  or hard discs (2D, scaled-particle theory: (1 - s)^3 / (1 + s)) at
+     *  solid fraction @p s: the part of a grain's own disturbance that its
+     *  neighbours' exclusion hole leaves in a kernel much wider than the
+     *  grain; 1 for a lone grain. */
+    static double
+    structure_factor(double s);
 
     /** The grain's own projected solid fraction at its centre, for a grain
      *  of volume @p volume at @p reference (unit cell coordinates) in a
