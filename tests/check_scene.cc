@@ -2,8 +2,10 @@
 // and its size estimated, nothing is written, and the regime is printed with
 // the choices that lie outside the validated range. The scene: 200 seed
 // beads in glycerine in a 3D box with cells of 2 grain diameters and the
-// cell-spread drag (a warning: grains feel their own disturbance there),
-// and the same with a Stokes fluid and the filtered drag (none).
+// cell-spread drag without the self-disturbance correction (a warning:
+// grains feel their own disturbance there), the same with the default
+// coupling (the correction on: none), and with a Stokes fluid and the
+// filtered drag (none).
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,7 +15,7 @@
 namespace fs = std::filesystem;
 
 void
-check(const std::string &name, const std::string &coupling)
+check(const std::string &name, const std::string &coupling, const bool stokes)
 {
   fs::remove_all("out_" + name);
   {
@@ -31,7 +33,7 @@ check(const std::string &name, const std::string &coupling)
          "subsection Fluid\n"
          "  set Density = 1200\n"
          "  set Viscosity = 0.12\n"
-      << (coupling.empty() ? "" : "  set Advection = false\n")
+      << (stokes ? "  set Advection = false\n" : "")
       << "end\n"
          "subsection Coupling\n"
       << coupling
@@ -66,8 +68,10 @@ check(const std::string &name, const std::string &coupling)
 int
 main()
 {
-  check("cell_spread", "");
+  check("cell_spread", "  set Self-disturbance correction = false\n", false);
+  check("default", "", false);
   check("filtered",
         "  set Drag distribution = filtered\n"
-        "  set Smoothing length = 1e-4\n");
+        "  set Smoothing length = 1e-4\n",
+        true);
 }

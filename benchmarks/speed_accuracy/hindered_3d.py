@@ -43,13 +43,14 @@ STRATEGIES = {
     "l_16r": ("filter length 16 r", "subsection Coupling\n  set Smoothing length = %g\nend\n" % (16 * R)),
     "corrected": ("filtered, l = 8 r, with the self-disturbance correction",
                   "subsection Coupling\n  set Self-disturbance correction = true\nend\n"),
-    "cell_spread": ("drag spread over the cell (the default distribution), no smoothing",
-                    "subsection Coupling\n  set Drag distribution = cell\n  set Smoothing length = 0\nend\n"),
-    "cell_spread_l": ("drag spread over the cell, solid fraction smoothed with l = 8 r",
-                      "subsection Coupling\n  set Drag distribution = cell\nend\n"),
-    "cell_corrected": ("drag spread over the cell, no smoothing, with the self-disturbance correction",
-                       "subsection Coupling\n  set Drag distribution = cell\n  set Smoothing length = 0\n"
-                       "  set Self-disturbance correction = true\nend\n"),
+    "cell_spread": ("drag spread over the cell, no smoothing, no correction",
+                    "subsection Coupling\n  set Drag distribution = cell\n  set Smoothing length = 0\n"
+                    "  set Self-disturbance correction = false\nend\n"),
+    "cell_spread_l": ("drag spread over the cell, solid fraction smoothed with l = 8 r, no correction",
+                      "subsection Coupling\n  set Drag distribution = cell\n"
+                      "  set Self-disturbance correction = false\nend\n"),
+    "cell_corrected": ("drag spread over the cell, no smoothing, with the self-disturbance correction (the 3D default)",
+                       "subsection Coupling\n  set Drag distribution = cell\n  set Smoothing length = 0\nend\n"),
     "tolerance_1e-6": ("outer tolerance 1e-6 (the default; the study runs 1e-10)",
                        "subsection Fluid\n  subsection Linear solver\n    set Tolerance = 1e-6\n  end\nend\n"),
 }

@@ -48,7 +48,7 @@ def main():
     else:
         results = []
         for h in [16, 8, 4, 2]:
-            for kind, options in [("cell", {}),
+            for kind, options in [("cell", {"correction": False}),
                                   ("cell+correction", {"correction": True}),
                                   ("filtered", {"smoothing_diameters": 4})]:
                 name = f"{kind}_{h}d"

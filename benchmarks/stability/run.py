@@ -80,7 +80,7 @@ def terminal(r, rho, rho_p, mu, dim, eps=1.0):
 def lone_grain(dim, r=12.5e-6, rho=1200.0, rho_p=2400.0, mu=0.12,
                cell_diameters=8.0, dt_over_tau=None, dt=1e-3,
                navier_stokes=False, smoothing_diameters=0.0, cells=None,
-               correction=False):
+               correction="auto"):
     """Parameter text, the analytical velocity (signed, along gravity's
     axis) and the number of fluid steps of a lone grain settling."""
     d = 2 * r
