@@ -114,13 +114,14 @@ namespace ImmersedGrains
   {
     prm.enter_subsection("Coupling");
     {
-      drag_law                     = prm.get("Drag law");
-      tracers                      = prm.get_bool("Tracers");
-      two_way                      = prm.get_bool("Two-way") && !tracers;
-      drag_distribution            = prm.get("Drag distribution");
-      implicit_coupling            = prm.get_bool("Implicit coupling");
-      grain_substeps               = prm.get_bool("Grain sub-steps");
-      resting_threshold            = prm.get_double("Resting threshold");
+      drag_law          = prm.get("Drag law");
+      tracers           = prm.get_bool("Tracers");
+      two_way           = prm.get_bool("Two-way") && !tracers;
+      drag_distribution = prm.get("Drag distribution");
+      implicit_coupling = prm.get_bool("Implicit coupling");
+      grain_substeps    = prm.get_bool("Grain sub-steps");
+      resting_threshold = prm.get_double("Resting threshold");
+
       const std::string correction = prm.get("Self-disturbance correction");
       self_correction              = correction == "auto" ?
                                        dim == 3 && drag_distribution == "cell" :
