@@ -225,6 +225,33 @@ namespace ImmersedGrains
         "fluid see the bound 1 - Minimum fluid fraction instead of the "
         "packing (doc/theory.md, \"Dense 2D beds\"); use Closure porosity "
         "in 2D = sphere packing for a packed 2D bed");
+    // The solid fraction of a ball or box placement, however it was given.
+    double placed_fraction = by_fraction ? grain_parameters.solid_fraction : 0;
+    if (!by_fraction && !grain_parameters.size.empty() &&
+        (grain_parameters.shape == PlacementShape::ball ||
+         grain_parameters.shape == PlacementShape::box))
+    {
+      double region = 1;
+      if (grain_parameters.shape == PlacementShape::ball)
+        region = grain_volume<dim>(grain_parameters.size[0]);
+      else
+        for (unsigned int c = 0; c < dim; ++c)
+          region *=
+            grain_parameters
+              .size[std::min<std::size_t>(c, grain_parameters.size.size() - 1)];
+      placed_fraction = placed_grains * grain_volume<dim>(r) / region;
+    }
+    if (two_way && dim == 3 && spread_in_cells && placed_fraction > 0.2 + 1e-9)
+      regime.warnings.push_back(
+        "grains placed at solid fraction " + number(placed_fraction, 2) +
+        " with Drag distribution = " + coupling_parameters.drag_distribution +
+        ": it is validated for suspensions up to 0.2; at 0.3 the grains' "
+        "mean velocity alternates from one fluid step to the next by up to "
+        "half the settling velocity (with the self-disturbance correction "
+        "on cells of 4 diameters, growing), and it settles 5 % below the "
+        "closure on cells of 4 diameters, 28 % above on 2 (doc/validation.md, "
+        "\"Dense suspensions\"); use Drag distribution = filtered with "
+        "Smoothing length of at least 16 grain radii (within 3.5 % at 0.3)");
     if (coupled && h < d && l < d)
       regime.warnings.push_back(
         "cells of " + number(h / d, 2) +

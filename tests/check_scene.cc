@@ -4,8 +4,9 @@
 // beads in glycerine in a 3D box with cells of 2 grain diameters and the
 // cell-spread drag without the self-disturbance correction (a warning:
 // grains feel their own disturbance there), the same with the default
-// coupling (the correction on: none), and with a Stokes fluid and the
-// filtered drag (none).
+// coupling (the correction on: none), with a Stokes fluid and the
+// filtered drag (none), and with the default coupling at a solid fraction
+// of 0.3 (a warning: the cell spread is validated up to 0.2).
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -15,7 +16,10 @@
 namespace fs = std::filesystem;
 
 void
-check(const std::string &name, const std::string &coupling, const bool stokes)
+check(const std::string &name,
+      const std::string &coupling,
+      const bool         stokes,
+      const unsigned int count = 200)
 {
   fs::remove_all("out_" + name);
   {
@@ -46,7 +50,9 @@ check(const std::string &name, const std::string &coupling, const bool stokes)
          "    set Shape = box\n"
          "    set Center = 4e-4, 4e-4, 4e-4\n"
          "    set Size = 6e-4\n"
-         "    set Count = 200\n"
+         "    set Count = "
+      << count
+      << "\n"
          "  end\n"
          "end\n"
          "subsection Gravity\n"
@@ -74,4 +80,6 @@ main()
         "  set Drag distribution = filtered\n"
         "  set Smoothing length = 1e-4\n",
         true);
+  // 0.3 of the placement's 6e-4 m cube: 0.3 (6e-4)^3 / (4/3 pi r^3).
+  check("dense", "", false, 7921);
 }
