@@ -1125,12 +1125,15 @@ namespace ImmersedGrains
     {
       // No contact impulse is known yet: a contact solve in the initial
       // fluid predicts the first, so that grains resting on each other at
-      // the start are held from the first step (prepare_fluid_drag()).
+      // the start are held from the first step (prepare_fluid_drag()), and
+      // starts the relaxed prediction there.
       coupling->set_substep_grain_forces(*grains, *fluid, dt);
       grains->compute_free_velocities(dt);
       grains->resolve_contacts(dt);
-      auto &c    = grains->step_arrays().contact;
-      c.velocity = c.start_velocity;
+      auto &arrays             = grains->step_arrays();
+      arrays.predicted_impulse = arrays.contact_impulse;
+      auto &c                  = arrays.contact;
+      c.velocity               = c.start_velocity;
     }
     coupling->prepare_fluid_drag(*grains, *fluid, dt);
     const auto stats = fluid->solve_time_step(time + dt, dt);

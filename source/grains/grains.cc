@@ -42,7 +42,10 @@ namespace ImmersedGrains
         l.self_velocity = add("self_velocity", dim, true);
       }
       if (with_fluid && prm.contacts_enabled)
-        l.contact_impulse = add("contact_impulse", dim, true);
+      {
+        l.contact_impulse   = add("contact_impulse", dim, true);
+        l.predicted_impulse = add("predicted_impulse", dim, true);
+      }
       if (prm.has_fixed_region)
         l.fixed = add("fixed", 1, false);
       return l;
@@ -391,6 +394,7 @@ namespace ImmersedGrains
     const bool impulses =
       properties.contact_impulse != GrainPropertyLayout::absent;
     arrays.contact_impulse.resize(impulses ? n : 0);
+    arrays.predicted_impulse.resize(impulses ? n : 0);
     const bool drags = properties.drag_force != GrainPropertyLayout::absent;
     arrays.drag_force.resize(drags ? n : 0);
     arrays.self_velocity.resize(drags ? n : 0);
@@ -411,7 +415,11 @@ namespace ImmersedGrains
           c.angular_velocity[i][d] = props[properties.angular_velocity + d];
       if (impulses)
         for (unsigned int d = 0; d < dim; ++d)
+        {
           arrays.contact_impulse[i][d] = props[properties.contact_impulse + d];
+          arrays.predicted_impulse[i][d] =
+            props[properties.predicted_impulse + d];
+        }
       if (drags)
         for (unsigned int d = 0; d < dim; ++d)
         {
@@ -620,7 +628,11 @@ namespace ImmersedGrains
         props[properties.velocity + d] = c.velocity[i][d];
       if (!arrays.contact_impulse.empty())
         for (unsigned int d = 0; d < dim; ++d)
+        {
           props[properties.contact_impulse + d] = arrays.contact_impulse[i][d];
+          props[properties.predicted_impulse + d] =
+            arrays.predicted_impulse[i][d];
+        }
       if (!arrays.drag_coefficient.empty() && !arrays.external_force.empty() &&
           properties.fluid_force != GrainPropertyLayout::absent)
       {

@@ -65,14 +65,15 @@ namespace ImmersedGrains
       void
       parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
-      std::string                             drag_law = "Dallavalle-Wen-Yu";
-      bool                                    two_way  = true;
-      bool                                    tracers  = false;
-      std::string                             drag_distribution = "cell";
-      bool                                    implicit_coupling = true;
-      bool                                    grain_substeps    = true;
-      double                                  resting_threshold = 1e-3;
-      bool                                    self_correction   = false;
+      std::string drag_law                  = "Dallavalle-Wen-Yu";
+      bool        two_way                   = true;
+      bool        tracers                   = false;
+      std::string drag_distribution         = "cell";
+      bool        implicit_coupling         = true;
+      bool        grain_substeps            = true;
+      double      resting_threshold         = 1e-3;
+      double      impulse_prediction_weight = 1. / 3;
+      bool        self_correction           = false;
       typename SolidFraction<dim>::Parameters projection;
     };
 
@@ -245,6 +246,9 @@ namespace ImmersedGrains
     std::vector<double>                 gamma;
     // The grain's own disturbance of the velocity it feels (undisturbed()).
     std::vector<dealii::Tensor<1, dim>> self_velocity;
+    // The contact impulse the fluid is told each grain will receive
+    // (prepare_fluid_drag()).
+    std::vector<dealii::Tensor<1, dim>> predicted_impulse;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 

@@ -33,15 +33,16 @@ namespace ImmersedGrains
     static constexpr unsigned int absent =
       dealii::numbers::invalid_unsigned_int;
 
-    unsigned int velocity         = 0;
-    unsigned int radius           = absent;
-    unsigned int angular_velocity = absent;
-    unsigned int fluid_force      = absent;
-    unsigned int drag_force       = absent;
-    unsigned int self_velocity    = absent;
-    unsigned int contact_impulse  = absent;
-    unsigned int fixed            = absent;
-    unsigned int n_properties     = 0;
+    unsigned int velocity          = 0;
+    unsigned int radius            = absent;
+    unsigned int angular_velocity  = absent;
+    unsigned int fluid_force       = absent;
+    unsigned int drag_force        = absent;
+    unsigned int self_velocity     = absent;
+    unsigned int contact_impulse   = absent;
+    unsigned int predicted_impulse = absent;
+    unsigned int fixed             = absent;
+    unsigned int n_properties      = 0;
 
     /** Names and interpretations per component, for particle output. */
     std::vector<std::string> names;
@@ -82,6 +83,11 @@ namespace ImmersedGrains
      *  The coupling predicts the drag the fluid receives with it, so that a
      *  grain held by contacts does not push the fluid. */
     std::vector<dealii::Tensor<1, dim>> contact_impulse;
+
+    /** With a fluid and contacts: the impulse the fluid was told each grain
+     *  would receive, of the last step on gather(); the coupling relaxes it
+     *  towards contact_impulse (Coupling/Impulse prediction weight). */
+    std::vector<dealii::Tensor<1, dim>> predicted_impulse;
 
     /** With a fluid: the drag each grain felt over its last step [N], of
      *  the last step on gather(); the coupling estimates the grain's own
