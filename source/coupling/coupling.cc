@@ -87,10 +87,10 @@ namespace ImmersedGrains
         "(1 - w) Q_last, P the grain's impulse of the last step. 1: the last "
         "impulse alone, which lets grains that collide and part in turn "
         "(dense suspensions) alternate with the fluid from step to step; "
-        "the default damps that alternation for contact responses down to "
-        "minus twice the prediction (doc/theory.md, \"Contacts and the "
-        "drag the fluid receives\"). Grains held by their contacts do not "
-        "use it.");
+        "the default removes that alternation where the impulses answer "
+        "with minus twice the prediction and damps it up to five times "
+        "(doc/theory.md, \"Contacts and the drag the fluid receives\"). "
+        "Grains held by their contacts do not use it.");
       prm.declare_entry(
         "Self-disturbance correction",
         "auto",
