@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 namespace ImmersedGrains
 {
@@ -540,6 +542,38 @@ namespace ImmersedGrains
     report.alert_distance = parameters.alert_distance > 0 ?
                               parameters.alert_distance :
                               0.1 * r_min + 3 * v_max * dt;
+    // The neighbour search needs a periodic axis at least twice the reach
+    // of a contact; a step whose grains outrun that says why, not where.
+    double r_max = 0;
+    for (const double r : c.radius)
+      r_max = std::max(r_max, r);
+    r_max             = dealii::Utilities::MPI::max(r_max, comm);
+    const auto number = [](const double x)
+    {
+      std::ostringstream s;
+      s << std::setprecision(3) << x;
+      return s.str();
+    };
+    for (unsigned int d = 0; d < dim; ++d)
+      if (geometry.is_periodic(d))
+      {
+        const double length =
+          geometry.upper_corner[d] - geometry.lower_corner[d];
+        AssertThrow(
+          length >= 2 * (2 * r_max + report.alert_distance),
+          dealii::ExcMessage(
+            "the grains' contact candidates reach " +
+            number(2 * r_max + report.alert_distance) + " m, more than half " +
+            "the periodic box's " + number(length) + " m: " +
+            (parameters.alert_distance > 0 ?
+               std::string("lower Contacts/Alert distance (") +
+                 number(parameters.alert_distance) + " m)" :
+               "its alert distance is three times the fastest grain's " +
+                 number(v_max) + " m/s over the step of " + number(dt) +
+                 " s; shorten the step or keep Coupling/Grain sub-steps on "
+                 "(if the grains are accelerating without bound, the run "
+                 "has diverged)")));
+      }
     std::vector<dealii::Tensor<1, dim>> free_velocity;
     if (!arrays.contact_impulse.empty())
       free_velocity = c.velocity;
