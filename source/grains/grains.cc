@@ -528,14 +528,19 @@ namespace ImmersedGrains
       return report;
     dealii::TimerOutput::Scope scope(timer, "grains: contacts");
     auto                      &c = arrays.contact;
-    double v_max = 0, r_min = std::numeric_limits<double>::max();
+    // Maxima of the speed and the radius, and minus the smallest radius,
+    // reduced together.
+    double maxima[3] = {0, 0, -std::numeric_limits<double>::max()};
     for (unsigned int i = 0; i < c.velocity.size(); ++i)
     {
-      v_max = std::max(v_max, c.velocity[i].norm());
-      r_min = std::min(r_min, c.radius[i]);
+      maxima[0] = std::max(maxima[0], c.velocity[i].norm());
+      maxima[1] = std::max(maxima[1], c.radius[i]);
+      maxima[2] = std::max(maxima[2], -c.radius[i]);
     }
-    v_max = dealii::Utilities::MPI::max(v_max, comm);
-    r_min = dealii::Utilities::MPI::min(r_min, comm);
+    dealii::Utilities::MPI::max(dealii::ArrayView<const double>(maxima, 3),
+                                comm,
+                                dealii::ArrayView<double>(maxima, 3));
+    const double v_max = maxima[0], r_max = maxima[1], r_min = -maxima[2];
     // Two grains close at most 2 v_max dt within the step (NSCD's
     // candidates are fixed at its start); the margin covers speed gained
     // in collisions.
@@ -544,10 +549,6 @@ namespace ImmersedGrains
                               0.1 * r_min + 3 * v_max * dt;
     // The neighbour search needs a periodic axis at least twice the reach
     // of a contact; a step whose grains outrun that says why, not where.
-    double r_max = 0;
-    for (const double r : c.radius)
-      r_max = std::max(r_max, r);
-    r_max             = dealii::Utilities::MPI::max(r_max, comm);
     const auto number = [](const double x)
     {
       std::ostringstream s;
