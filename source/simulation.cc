@@ -620,6 +620,15 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  bool
+  Simulation<dim>::tracks_grain_travel() const
+  {
+    return adaptivity && grains && adaptivity_parameters.follow_grains &&
+           adaptivity_parameters.around_grains;
+  }
+
+
+  template <int dim>
   void
   Simulation<dim>::update_shortest_cell_edge()
   {
@@ -688,8 +697,41 @@ namespace ImmersedGrains
   void
   Simulation<dim>::maybe_adapt_mesh()
   {
-    if (adaptivity && step > 0 && adaptivity->due(step) && adapt_mesh())
-      return;
+    if (adaptivity && step > 0)
+    {
+      double reach = 0;
+      if (tracks_grain_travel())
+      {
+        // The step about to be taken counts: the band must hold the
+        // grains until its end.
+        step_start_speed   = grains->max_speed();
+        const double ahead = step_start_speed * next_time_step();
+        reach              = grain_travel + ahead;
+        if (!warned_band_outrun &&
+            ahead > 2 * adaptivity->travel_allowance(shortest_cell_edge))
+        {
+          warned_band_outrun = true;
+          pcout << "  warning: step " << step + 1
+                << ": the fastest grain crosses " << std::setprecision(3)
+                << ahead / shortest_cell_edge
+                << " of the finest cells in one fluid step, more than the "
+                   "band around the grains (Adaptivity/Band width = "
+                << adaptivity_parameters.band_width
+                << "): grains leave the refined cells between adaptations; "
+                   "widen the band or shorten the step (Courant number, Time "
+                   "step)\n"
+                << std::setprecision(6);
+        }
+      }
+      if (adaptivity->due(
+            step, reach, shortest_cell_edge, static_cast<bool>(grains)))
+      {
+        // The band is made around where the grains are now.
+        grain_travel = 0;
+        if (adapt_mesh())
+          return;
+      }
+    }
     if (!load_balance)
       return;
     // Collective: every rank computes the same global figure.
@@ -785,6 +827,7 @@ namespace ImmersedGrains
       for (const auto &[t, file] : *records)
         out << std::hexfloat << t << ' ' << file << '\n';
     }
+    out << "grain_travel " << std::hexfloat << grain_travel << '\n';
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
@@ -820,6 +863,17 @@ namespace ImmersedGrains
         in >> text >> file;
         records->emplace_back(std::strtod(text.c_str(), nullptr), file);
       }
+    }
+    // Absent from checkpoints written before Adaptivity/Every steps = auto:
+    // the next adaptation then comes a little later than it would have.
+    grain_travel        = 0;
+    const auto position = in.tellg();
+    if (in >> text && text == "grain_travel" && in >> text)
+      grain_travel = std::strtod(text.c_str(), nullptr);
+    else
+    {
+      in.clear();
+      in.seekg(position);
     }
     statistics.load_values(in);
     AssertThrow(!in.bad(),
@@ -882,6 +936,8 @@ namespace ImmersedGrains
     try
     {
       prepare_output_directory(resumed_step);
+      if (resume_from.empty())
+        checkpoint->discard_earlier_runs();
       setup(resume_from);
       start_time          = time;
       initial_grain_speed = grains ? grains->max_speed() : 0.0;
@@ -903,6 +959,9 @@ namespace ImmersedGrains
         solve_time_step_or_retry(dt);
         stop_if_not_finite();
         stop_if_speeding();
+        if (tracks_grain_travel())
+          grain_travel +=
+            last_step * std::max(step_start_speed, grains->max_speed());
         in_step = false;
         maybe_write_fields(time >= end_time * (1 - 1e-12));
         record_timings();

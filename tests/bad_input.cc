@@ -237,6 +237,11 @@ end
              " set Min level = 4\n set Max level = 3\nend\n",
          "Min level",
          "4"},
+        {"adaptivity_every_steps_not_a_number",
+         "set Dimension = 2\nsubsection Adaptivity\n set Every steps = "
+             "often\nend\n",
+         "Every steps",
+         "often"},
         {"resume_without_checkpoint",
          "set Dimension = 2\nsubsection Checkpoint\n set Resume = true\nend\n",
          "Resume",

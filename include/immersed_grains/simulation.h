@@ -102,6 +102,10 @@ namespace ImmersedGrains
     // are uneven.
     void
     maybe_adapt_mesh();
+    /** Whether adaptations follow the grains' travel (Adaptivity/Every
+     *  steps = auto with the grain band). */
+    bool
+    tracks_grain_travel() const;
     void
     update_shortest_cell_edge();
     double
@@ -182,6 +186,12 @@ namespace ImmersedGrains
     // The length of the last step taken (0 before the first, and on
     // resuming): an adaptive step grows by at most twice it.
     double last_step = 0;
+    // How far the fastest grain may have travelled since the last
+    // adaptation (a sum of the largest speed over each step times the
+    // step), and that speed at the start of the step being taken.
+    double grain_travel       = 0;
+    double step_start_speed   = 0;
+    bool   warned_band_outrun = false;
     // The largest speed over the driven speed so far, and that speed then.
     double largest_speed_ratio = 0;
     double driven_at_largest   = 0;

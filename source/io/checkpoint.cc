@@ -81,6 +81,23 @@ namespace ImmersedGrains
   }
 
 
+  void
+  Checkpoint::discard_earlier_runs() const
+  {
+    if (dealii::Utilities::MPI::this_mpi_process(comm) == 0 &&
+        std::filesystem::is_directory(directory))
+    {
+      std::vector<std::filesystem::path> sets;
+      for (const auto &entry : std::filesystem::directory_iterator(directory))
+        if (entry.path().filename().string().rfind("step_", 0) == 0)
+          sets.push_back(entry.path());
+      for (const auto &set : sets)
+        std::filesystem::remove_all(set);
+    }
+    MPI_Barrier(comm);
+  }
+
+
   std::string
   Checkpoint::newest() const
   {

@@ -36,14 +36,17 @@ namespace ImmersedGrains
                         "5",
                         Integer(0, 12),
                         "Finest refinement level, reached around the grains.");
-      prm.declare_entry("Every steps",
-                        "5",
-                        Integer(0),
-                        "Adapt the mesh before every this many fluid steps "
-                        "(0: only before the first). Between two adaptations "
-                        "the grains must stay inside the band: at the "
-                        "default Courant number 0.1 they cross half a finest "
-                        "cell in 5 steps, and the band is 2 cells wide.");
+      prm.declare_entry(
+        "Every steps",
+        "auto",
+        Anything(),
+        "auto: adapt the mesh before the step in which the fastest grain "
+        "could have travelled half the band (Band width / 2 of the finest "
+        "cells) since the last adaptation, counting the step about to be "
+        "taken: the grains stay inside the band whatever the time step, and "
+        "the mesh is left alone while they are slow (with Criteria = "
+        "velocity, also every 5 steps). A number N: adapt before every N-th "
+        "fluid step (0: only before the first).");
       prm.declare_entry(
         "Criteria",
         "grains",
@@ -88,10 +91,22 @@ namespace ImmersedGrains
     const InputLocation where{file, "Adaptivity"};
     prm.enter_subsection("Adaptivity");
     {
-      enabled     = prm.get_bool("Enabled");
-      min_level   = prm.get_integer("Min level");
-      max_level   = prm.get_integer("Max level");
-      every_steps = prm.get_integer("Every steps");
+      enabled                 = prm.get_bool("Enabled");
+      min_level               = prm.get_integer("Min level");
+      max_level               = prm.get_integer("Max level");
+      const std::string every = prm.get("Every steps");
+      follow_grains           = every == "auto";
+      if (!follow_grains)
+      {
+        char      *end   = nullptr;
+        const long value = std::strtol(every.c_str(), &end, 10);
+        const bool whole = !every.empty() && end != nullptr && *end == '\0';
+        where.require(whole && value >= 0,
+                      "Every steps",
+                      every,
+                      "is neither auto nor a number of steps (0 or more)");
+        every_steps = static_cast<unsigned int>(value);
+      }
       const auto criteria =
         dealii::Utilities::split_string_list(prm.get("Criteria"));
       around_grains =
@@ -226,6 +241,27 @@ namespace ImmersedGrains
           static_cast<unsigned int>(marked[index[0]]);
       }
     return band;
+  }
+
+
+  template <int dim>
+  bool
+  Adaptivity<dim>::due(const unsigned int step,
+                       const double       grain_reach,
+                       const double       shortest_edge,
+                       const bool         with_grains) const
+  {
+    if (!parameters.enabled)
+      return false;
+    if (!parameters.follow_grains)
+      return parameters.every_steps > 0 && step % parameters.every_steps == 0;
+    // The band moves with the grains; the velocity criterion keeps the
+    // fixed rhythm it had (the wake does not announce its motion).
+    const bool by_grains = parameters.around_grains && with_grains;
+    const bool by_velocity =
+      parameters.velocity_kelly || !by_grains ? step % 5 == 0 : false;
+    return by_velocity || (by_grains && grain_reach > 0 &&
+                           grain_reach >= travel_allowance(shortest_edge));
   }
 
 

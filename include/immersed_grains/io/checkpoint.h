@@ -42,6 +42,12 @@ namespace ImmersedGrains
                const std::string &output_directory,
                MPI_Comm           comm);
 
+    /** Removes the checkpoints an earlier run left (collective): a run
+     *  that starts afresh writes its own history, and the sets of another
+     *  would be taken for its newest. */
+    void
+    discard_earlier_runs() const;
+
     /** The newest complete checkpoint directory, or "" (collective). */
     std::string
     newest() const;

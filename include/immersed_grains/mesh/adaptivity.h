@@ -34,9 +34,12 @@ namespace ImmersedGrains
                        const std::string        &file,
                        bool                      fluid_enabled);
 
-      bool         enabled          = false;
-      unsigned int min_level        = 2;
-      unsigned int max_level        = 5;
+      bool         enabled   = false;
+      unsigned int min_level = 2;
+      unsigned int max_level = 5;
+      // Every steps = auto: by the grains' travel (travel_allowance()),
+      // and with the velocity criterion every 5 steps too.
+      bool         follow_grains    = true;
       unsigned int every_steps      = 5;
       bool         around_grains    = true;
       bool         velocity_kelly   = false;
@@ -61,12 +64,27 @@ namespace ImmersedGrains
     mark_cells(const dealii::Particles::ParticleHandler<dim> *grains,
                const FluidSolver<dim>                        *fluid);
 
-    /** Whether the mesh should change before step @p step. */
+    /**
+     * Whether the mesh should change before step @p step, when the grains
+     * may have travelled @p grain_reach since the last adaptation by the
+     * end of that step, on a mesh whose shortest cell edge is
+     * @p shortest_edge. (@p grain_reach is ignored without Every steps =
+     * auto or without grains.)
+     */
     bool
-    due(unsigned int step) const
+    due(unsigned int step,
+        double       grain_reach,
+        double       shortest_edge,
+        bool         with_grains) const;
+
+    /** How far a grain may travel between two adaptations before it could
+     *  leave the band: half of it, Band width / 2 cells of @p shortest_edge
+     *  (the band's cells are the finest, or the grains' cells are coarser
+     *  and the margin larger). */
+    double
+    travel_allowance(double shortest_edge) const
     {
-      return parameters.enabled && parameters.every_steps > 0 &&
-             step % parameters.every_steps == 0;
+      return 0.5 * parameters.band_width * shortest_edge;
     }
 
   private:
