@@ -267,9 +267,14 @@ namespace ImmersedGrains
       , statistics(statistics_columns(dim))
       , timings(timing_columns())
       , triangulation(comm,
+                      // Level differences at vertices only: with the island
+                      // rules too, coarsening the children of a cell whose
+                      // neighbours are refined made it an unrefined island,
+                      // refined again by the next adaptation, and so on:
+                      // the mesh around still grains never settled.
                       typename dealii::Triangulation<dim>::MeshSmoothing(
-                        dealii::Triangulation<dim>::smoothing_on_refinement |
-                        dealii::Triangulation<dim>::smoothing_on_coarsening))
+                        dealii::Triangulation<
+                          dim>::limit_level_difference_at_vertices))
       , wall_start(now())
       , last_timing_wall(wall_start)
   {
