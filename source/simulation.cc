@@ -266,15 +266,15 @@ namespace ImmersedGrains
                 dealii::Utilities::MPI::this_mpi_process(comm) == 0)
       , statistics(statistics_columns(dim))
       , timings(timing_columns())
-      , triangulation(comm,
-                      // Level differences at vertices only: with the island
-                      // rules too, coarsening the children of a cell whose
-                      // neighbours are refined made it an unrefined island,
-                      // refined again by the next adaptation, and so on:
-                      // the mesh around still grains never settled.
-                      typename dealii::Triangulation<dim>::MeshSmoothing(
-                        dealii::Triangulation<
-                          dim>::limit_level_difference_at_vertices))
+      , triangulation(
+          comm,
+          // Level differences at vertices only: with the island
+          // rules too, coarsening the children of a cell whose
+          // neighbours are refined made it an unrefined island,
+          // refined again by the next adaptation, and so on:
+          // the mesh around still grains never settled.
+          typename dealii::Triangulation<dim>::MeshSmoothing(
+            dealii::Triangulation<dim>::limit_level_difference_at_vertices))
       , wall_start(now())
       , last_timing_wall(wall_start)
   {
@@ -712,7 +712,8 @@ namespace ImmersedGrains
         step_start_speed   = grains->max_speed();
         const double ahead = step_start_speed * next_time_step();
         reach              = grain_travel + ahead;
-        if (!warned_band_outrun &&
+        // (Band width = 0 asks for no margin: nothing to warn about.)
+        if (!warned_band_outrun && adaptivity_parameters.band_width > 0 &&
             ahead > 2 * adaptivity->travel_allowance(shortest_cell_edge))
         {
           warned_band_outrun = true;

@@ -259,7 +259,7 @@ namespace ImmersedGrains
     // fixed rhythm it had (the wake does not announce its motion).
     const bool by_grains = parameters.around_grains && with_grains;
     const bool by_velocity =
-      parameters.velocity_kelly || !by_grains ? step % 5 == 0 : false;
+      (parameters.velocity_kelly || !by_grains) && step % 5 == 0;
     return by_velocity || (by_grains && grain_reach > 0 &&
                            grain_reach >= travel_allowance(shortest_edge));
   }

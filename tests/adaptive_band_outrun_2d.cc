@@ -1,0 +1,84 @@
+// Adaptivity/Every steps = auto warns, once, when the fastest grain
+// crosses more than the band of refined cells around the grains in a
+// single fluid step: the 81-disc cloud of the checkpoint tests (0.3 mm/s,
+// cells of 125 um at Max level 4, a band of 2 cells) with fluid steps of
+// 1 s (300 um per step, the grains sub-stepping inside), against the same
+// scene at its own step of 0.05 s (15 um per step: no warning). Also
+// checked: with steps of 1 s the mesh adapts before every step (the
+// travel of one step exceeds half the band).
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <immersed_grains/parameters.h>
+#include <immersed_grains/simulation.h>
+
+#include "checkpoint_test_support.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <string>
+
+using namespace dealii;
+using namespace ImmersedGrains;
+
+namespace
+{
+  // The number of times @p text occurs in @p directory's log.
+  unsigned int
+  count_in_log(const std::string &directory, const std::string &text)
+  {
+    std::ifstream     in(directory + "/log.txt");
+    const std::string log((std::istreambuf_iterator<char>(in)),
+                          std::istreambuf_iterator<char>());
+    unsigned int      n = 0;
+    for (auto at = log.find(text); at != std::string::npos;
+         at      = log.find(text, at + 1))
+      ++n;
+    return n;
+  }
+
+
+  void
+  run(const std::string &directory,
+      const double       time_step,
+      const double       end_time)
+  {
+    std::filesystem::remove_all(directory);
+    const std::string file = directory + ".prm";
+    {
+      std::ofstream prm(file);
+      prm << adaptive_cloud_scene << "set Time step = " << time_step
+          << "\nset End time = " << end_time
+          << "\nset Output directory = " << directory
+          << "\nsubsection Adaptivity\n  set Every steps = auto\nend\n";
+    }
+    ParameterHandler prm;
+    Simulation<2>::declare_parameters(prm);
+    parse_parameter_file(prm, file);
+    Simulation<2> simulation(prm, file, MPI_COMM_WORLD);
+    simulation.run();
+  }
+} // namespace
+
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  run("long_steps", 1, 3);
+  run("short_steps", 0.05, 0.15);
+  const std::string warning = "warning: step";
+  std::cout << "steps of 1 s: band warnings "
+            << count_in_log("long_steps", warning) << ", mentions Band width: "
+            << (count_in_log("long_steps", "Adaptivity/Band width") > 0 ?
+                  "yes" :
+                  "no")
+            << ", adaptations before steps 2 and 3: "
+            << count_in_log("long_steps", "mesh adapted before step 2") +
+                 count_in_log("long_steps", "mesh adapted before step 3")
+            << '\n';
+  std::cout << "steps of 0.05 s: band warnings "
+            << count_in_log("short_steps", warning) << '\n';
+}
