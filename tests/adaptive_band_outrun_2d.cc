@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
 using namespace dealii;
@@ -46,19 +47,12 @@ namespace
       const double       end_time)
   {
     std::filesystem::remove_all(directory);
-    const std::string file = directory + ".prm";
-    {
-      std::ofstream prm(file);
-      prm << adaptive_cloud_scene << "set Time step = " << time_step
-          << "\nset End time = " << end_time
-          << "\nset Output directory = " << directory
-          << "\nsubsection Adaptivity\n  set Every steps = auto\nend\n";
-    }
-    ParameterHandler prm;
-    Simulation<2>::declare_parameters(prm);
-    parse_parameter_file(prm, file);
-    Simulation<2> simulation(prm, file, MPI_COMM_WORLD);
-    simulation.run();
+    std::ostringstream text;
+    text << adaptive_cloud_scene << "set Time step = " << time_step
+         << "\nset End time = " << end_time
+         << "\nset Output directory = " << directory
+         << "\nsubsection Adaptivity\n  set Every steps = auto\nend\n";
+    run_2d_scene(directory + ".prm", text.str());
   }
 } // namespace
 

@@ -45,24 +45,13 @@ namespace
       MPI_Comm           comm     = MPI_COMM_WORLD,
       const std::string &schedule = "")
   {
-    const std::string file = directory + ".prm";
-    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-    {
-      std::ofstream prm(file);
-      prm << adaptive_cloud_scene << "set End time = " << end_time
-          << "\nset Output directory = " << directory
-          << "\nsubsection Checkpoint\n  set Every steps = 2\n  set Resume = "
-          << (resume ? "true" : "false") << "\nend\n"
-          << schedule;
-    }
-    MPI_Barrier(MPI_COMM_WORLD);
-    if (comm == MPI_COMM_NULL)
-      return;
-    ParameterHandler prm;
-    Simulation<2>::declare_parameters(prm);
-    parse_parameter_file(prm, file);
-    Simulation<2> simulation(prm, file, comm);
-    simulation.run();
+    std::ostringstream text;
+    text << adaptive_cloud_scene << "set End time = " << end_time
+         << "\nset Output directory = " << directory
+         << "\nsubsection Checkpoint\n  set Every steps = 2\n  set Resume = "
+         << (resume ? "true" : "false") << "\nend\n"
+         << schedule;
+    run_2d_scene(directory + ".prm", text.str(), comm);
   }
 
 } // namespace

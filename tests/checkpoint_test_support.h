@@ -7,6 +7,12 @@
 #ifndef immersed_grains_tests_checkpoint_test_support_h
 #define immersed_grains_tests_checkpoint_test_support_h
 
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <immersed_grains/parameters.h>
+#include <immersed_grains/simulation.h>
+
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -53,6 +59,26 @@ subsection Output
   set Terminal output = quiet
 end
 )";
+
+// Writes @p text to @p file (rank 0 of MPI_COMM_WORLD) and runs it as a 2D
+// scene on @p comm; the ranks outside @p comm (MPI_COMM_NULL) only wait
+// for the file.
+inline void
+run_2d_scene(const std::string &file,
+             const std::string &text,
+             MPI_Comm           comm = MPI_COMM_WORLD)
+{
+  if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+    std::ofstream(file) << text;
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm == MPI_COMM_NULL)
+    return;
+  dealii::ParameterHandler prm;
+  ImmersedGrains::Simulation<2>::declare_parameters(prm);
+  ImmersedGrains::parse_parameter_file(prm, file);
+  ImmersedGrains::Simulation<2> simulation(prm, file, comm);
+  simulation.run();
+}
 
 // The fields of every line of a CSV file (statistics.csv), header first.
 inline std::vector<std::vector<std::string>>
