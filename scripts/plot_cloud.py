@@ -11,7 +11,10 @@ writes
                 the cloud's centroid (by default the start, half the
                 break-up time, the break-up, a third of the way from there
                 to the end, and the end; without a break-up five instants
-                evenly spaced);
+                evenly spaced); in 3D a second row shows only the grains
+                in a vertical slab through the centroid (|y - y_c| below a
+                fifth of the cloud's initial radius, --slab), where a torus
+                shows as two blobs with a gap between them;
   P_flow.png    at two instants: the pressure less its hydrostatic part
                 (colour) and the streamlines of the fluid velocity, with the
                 grains on top (by default the middle of the run and just
@@ -97,14 +100,15 @@ def nearest(states, t):
     return min(states, key=lambda s: abs(s[0] - t))
 
 
-def grains_at(pieces, with_ids=False):
+def grains_at(pieces, with_ids=False, full=False):
+    """The grains' drawn coordinates (all three with @p full)."""
     points, ids = [], []
     for path in pieces:
         x, arrays, _ = read_vtu(path)
         if len(x):
-            points.append(view(x))
+            points.append(x if full else view(x))
             ids.append(arrays["id"].astype(np.int64))
-    x = np.concatenate(points) if points else np.zeros((0, 2))
+    x = np.concatenate(points) if points else np.zeros((0, 3 if full else 2))
     if with_ids:
         return x, (np.concatenate(ids) if ids else np.zeros(0, np.int64))
     return x
@@ -143,25 +147,38 @@ def frame(axes, centre, half_width):
     axes.set_yticks([])
 
 
-def plot_stages(directory, stats, times, half_width, out, groups):
+def plot_stages(directory, stats, times, half_width, out, groups, slab=0.0):
     particles = written_states(directory, "particles")
     n_grains = int(stats["particles"][0])
-    figure, panels = plt.subplots(1, len(times),
-                                  figsize=(2.6 * len(times), 3.0))
-    for axes, t in zip(np.atleast_1d(panels), times):
+    rows = 2 if VERTICAL == "z" else 1
+    figure, panels = plt.subplots(rows, len(times), squeeze=False,
+                                  figsize=(2.6 * len(times), 3.0 * rows))
+    for column, t in enumerate(times):
         t_state, pieces = nearest(particles, t)
-        x, ids = grains_at(pieces, with_ids=True)
+        x, ids = grains_at(pieces, with_ids=True, full=rows == 2)
         centre = centroid_at(stats, t_state)
-        colour = ("k" if groups == 1 else
-                  np.array(["k", "tab:red", "tab:blue", "tab:green"])[
-                      group_of(ids, n_grains, groups) % 4])
-        axes.scatter(x[:, 0], x[:, 1], s=1.2 if VERTICAL == "y" else 0.3,
-                     c=colour, edgecolors="none",
-                     alpha=1 if VERTICAL == "y" else 0.4)
-        frame(axes, centre, half_width)
-        axes.set_title("t = %.3g s" % t_state, fontsize=10)
-    np.atleast_1d(panels)[0].set_ylabel("%.2g mm frames on the centroid"
-                                        % (2e3 * half_width), fontsize=8)
+        colour = np.array(["k", "tab:red", "tab:blue", "tab:green"])[
+            group_of(ids, n_grains, groups) % 4]
+        for row in range(rows):
+            axes = panels[row][column]
+            shown = np.ones(len(x), dtype=bool)
+            if rows == 2 and row == 1:
+                y_c = np.interp(t_state, stats["time"],
+                                stats["cloud_centroid_y"])
+                shown = np.abs(x[:, 1] - y_c) < slab
+            drawn = view(x[shown]) if rows == 2 else x
+            axes.scatter(drawn[:, 0], drawn[:, 1],
+                         s=1.2 if VERTICAL == "y" or row == 1 else 0.3,
+                         c=colour[shown], edgecolors="none",
+                         alpha=1 if VERTICAL == "y" or row == 1 else 0.4)
+            frame(axes, centre, half_width)
+            if row == 0:
+                axes.set_title("t = %.3g s" % t_state, fontsize=10)
+    panels[0][0].set_ylabel("%.2g mm frames on the centroid"
+                            % (2e3 * half_width), fontsize=8)
+    if rows == 2:
+        panels[1][0].set_ylabel("slab |y - y_c| < %.2g mm" % (1e3 * slab),
+                                fontsize=8)
     figure.tight_layout()
     figure.savefig(out, dpi=150)
     plt.close(figure)
@@ -383,6 +400,10 @@ def main():
     parser.add_argument("--reference-velocity", type=float,
                         help="a velocity [m/s] to draw beside the cloud's "
                         "(e.g. the Hadamard-Rybczynski estimate)")
+    parser.add_argument("--slab", type=float,
+                        help="3D: half the thickness of the slab through "
+                        "the centroid drawn in the second row [m] (default: "
+                        "a fifth of the cloud's initial radius)")
     parser.add_argument("--half-width", type=float,
                         help="half the side of each frame [m] (default: "
                         "six times the cloud's initial radius of gyration)")
@@ -400,8 +421,10 @@ def main():
     flow = times_option(args.flow, 2, "--flow") or \
         [0.5 * (breakup if breakup > 0 else end),
          min(end, 1.2 * breakup) if breakup > 0 else end]
+    # A uniform ball's radius of gyration per axis is R / sqrt(5).
+    slab = args.slab or 0.2 * np.sqrt(5) * stats["cloud_extent_x"][0]
     plot_stages(args.directory, stats, stages, half_width,
-                prefix + "_stages.png", args.groups)
+                prefix + "_stages.png", args.groups, slab)
     if VERTICAL == "y":
         plot_flow(args.directory, stats, flow, half_width,
                   prefix + "_flow.png")
