@@ -708,8 +708,10 @@ namespace ImmersedGrains
       if (tracks_grain_travel())
       {
         // The step about to be taken counts: the band must hold the
-        // grains until its end.
-        step_start_speed   = grains->max_speed();
+        // grains until its end. (The last step's statistics hold the
+        // grains' largest speed, reduced over the ranks; a checkpoint
+        // carries it.)
+        step_start_speed   = statistics.get("max_speed");
         const double ahead = step_start_speed * next_time_step();
         reach              = grain_travel + ahead;
         // (Band width = 0 asks for no margin: nothing to warn about.)
@@ -967,7 +969,7 @@ namespace ImmersedGrains
         stop_if_speeding();
         if (tracks_grain_travel())
           grain_travel +=
-            last_step * std::max(step_start_speed, grains->max_speed());
+            last_step * std::max(step_start_speed, statistics.get("max_speed"));
         in_step = false;
         maybe_write_fields(time >= end_time * (1 - 1e-12));
         record_timings();
