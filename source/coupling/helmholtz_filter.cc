@@ -209,7 +209,7 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  const dealii::MappingQ1<dim> &
+  const dealii::MappingCartesian<dim> &
   HelmholtzFilter<dim>::get_mapping() const
   {
     return mapping;

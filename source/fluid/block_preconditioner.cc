@@ -35,10 +35,14 @@ namespace ImmersedGrains
       // the outer iterations there (doc/benchmarks.md).
       // Also measured with the drag jumping by 1e8 (doc/benchmarks.md):
       // 4 ILU sweeps, Chebyshev, symmetric Gauss-Seidel and aggregation
-      // thresholds 0 or 0.1 were all as good or worse.
+      // thresholds 0 or 0.1 were all as good or worse. One sweep before
+      // and after rather than two: 0-5 % more outer iterations on the
+      // preconditioner benchmarks, but each V-cycle costs about half, and
+      // the solves took 16-45 % less time (doc/performance.md, eighth
+      // round).
       data.smoother_type         = "ILU";
-      data.smoother_sweeps       = 2;
-      data.aggregation_threshold = 0.02;
+      data.smoother_sweeps       = 1;
+      data.aggregation_threshold = settings.velocity_aggregation_threshold;
       // Each rank's ILU sees one layer of its neighbours' rows: where drag
       // dominates, the drag's own mass-matrix couplings cross the rank
       // boundary, and without the overlap 2 ranks needed 34-51 iterations

@@ -90,6 +90,7 @@ namespace ImmersedGrains
     settings.inner_iterations = parameters.velocity_inner_iterations;
     settings.inner_tolerance  = parameters.velocity_inner_tolerance;
     settings.pressure_mass_iterations = parameters.pressure_mass_iterations;
+    settings.velocity_aggregation_threshold = dim == 2 ? 0.05 : 0.02;
     const dealii::FEValuesExtractors::Vector velocities(0);
     dealii::DoFTools::extract_constant_modes(dof_handler,
                                              fe.component_mask(velocities),

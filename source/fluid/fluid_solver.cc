@@ -92,9 +92,9 @@ namespace ImmersedGrains
       }
 
     private:
-      const MixtureFields<dim>    &fields;
-      const double                 time;
-      const dealii::MappingQ1<dim> mapping;
+      const MixtureFields<dim>           &fields;
+      const double                        time;
+      const dealii::MappingCartesian<dim> mapping;
     };
   } // namespace
 

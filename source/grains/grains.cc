@@ -105,18 +105,8 @@ namespace ImmersedGrains
       {
         if (!candidate->is_locally_owned())
           continue;
-        dealii::Point<dim> p;
-        try
-        {
-          p = mapping.transform_real_to_unit_cell(candidate, x);
-        }
-        catch (const typename dealii::Mapping<dim>::ExcTransformationFailed &)
-        {
-          // MappingQ1's Newton iteration can fail exactly at a vertex; the
-          // affine approximation is exact on box meshes and close enough
-          // on others for the test below.
-          p = candidate->real_to_unit_cell_affine_approximation(x);
-        }
+        const dealii::Point<dim> p =
+          mapping.transform_real_to_unit_cell(candidate, x);
         const double distance =
           dealii::GeometryInfo<dim>::distance_to_unit_cell(p);
         if (distance < best)

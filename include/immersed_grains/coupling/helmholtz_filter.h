@@ -5,7 +5,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_q.h>
-#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -81,7 +81,7 @@ namespace ImmersedGrains
     const dealii::FE_Q<dim> &
     get_fe() const;
 
-    const dealii::MappingQ1<dim> &
+    const dealii::MappingCartesian<dim> &
     get_mapping() const;
 
     const dealii::IndexSet &
@@ -92,7 +92,7 @@ namespace ImmersedGrains
     const Geometry<dim>                                     &geometry;
     dealii::FE_Q<dim>                                        fe;
     dealii::DoFHandler<dim>                                  dof_handler;
-    dealii::MappingQ1<dim>                                   mapping;
+    dealii::MappingCartesian<dim>                            mapping;
     dealii::AffineConstraints<double>                        constraints;
     dealii::IndexSet                                         owned, relevant;
     dealii::TrilinosWrappers::SparseMatrix                   matrix;

@@ -49,6 +49,12 @@ namespace ImmersedGrains
       // preconditioned by the ILU.
       unsigned int pressure_mass_iterations = 3;
 
+      // The AMG's aggregation threshold for A: the strength below which a
+      // coupling is dropped when the aggregates are formed. 0.05 suits the
+      // 2D Q2 blocks; in 3D it doubled the set-up at 10^5 DoFs
+      // (doc/performance.md, eighth round).
+      double velocity_aggregation_threshold = 0.02;
+
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
     };

@@ -4,7 +4,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/tria.h>
-#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/grid/grid_tools_cache.h>
 #include <deal.II/numerics/data_component_interpretation.h>
 #include <deal.II/particles/particle_handler.h>
@@ -279,7 +279,7 @@ namespace ImmersedGrains
     MPI_Comm                                                 comm;
     dealii::TimerOutput                                     &timer;
 
-    dealii::MappingQ1<dim>                  mapping;
+    dealii::MappingCartesian<dim>           mapping;
     GrainPropertyLayout                     properties;
     dealii::Particles::ParticleHandler<dim> particles;
     /// Cells around each vertex, for rescue_lost_grain() (built on first

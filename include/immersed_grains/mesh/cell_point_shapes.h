@@ -13,12 +13,12 @@ namespace ImmersedGrains
   /**
    * Values and real-space gradients of a scalar finite element's shape
    * functions at given reference points of a cell under the d-linear
-   * (MappingQ1) map. The same point set comes back at every cell of an
-   * assembly (its quadrature points), so the reference values and
-   * gradients are kept until the points change, and a cell costs only its
-   * Jacobians. This replaces a dealii::FEPointEvaluation built per cell,
-   * whose set-up (tensor-product shape data) cost more than the evaluation
-   * itself: 12 % of a 2D cloud step (doc/performance.md).
+   * map (exact on the axis-parallel cells of a box mesh). The same point set
+   * comes back at every cell of an assembly (its quadrature points), so the
+   * reference values and gradients are kept until the points change, and a cell
+   * costs only its Jacobians. This replaces a dealii::FEPointEvaluation built
+   * per cell, whose set-up (tensor-product shape data) cost more than the
+   * evaluation itself: 12 % of a 2D cloud step (doc/performance.md).
    */
   template <int dim>
   class CellPointShapes
