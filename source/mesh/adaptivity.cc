@@ -12,8 +12,88 @@
 #include <immersed_grains/mesh/adaptivity.h>
 #include <immersed_grains/parameters.h>
 
+#include <array>
+#include <limits>
+#include <map>
+
 namespace ImmersedGrains
 {
+  namespace
+  {
+    // For each vertex on a periodic face of the box, the vertices that
+    // periodicity identifies with it: its image across that face and, where
+    // periodic faces meet, across their edges and corners. Cells around
+    // either touch through the periodic boundary. Empty without
+    // periodicity. The coordinates compare exactly: a box mesh's vertices
+    // on one face share the coordinate normal to it, and those along it are
+    // computed the same way on the opposite face.
+    template <int dim>
+    std::vector<std::vector<unsigned int>>
+    periodic_vertex_images(const dealii::Triangulation<dim> &triangulation)
+    {
+      std::vector<std::vector<unsigned int>> images;
+      std::array<bool, dim>                  periodic{};
+      bool                                   any = false;
+      for (const auto &entry : triangulation.get_periodic_face_map())
+      {
+        periodic[entry.first.second / 2] = true;
+        any                              = true;
+      }
+      if (!any)
+        return images;
+
+      const auto              &vertices = triangulation.get_vertices();
+      const std::vector<bool> &used     = triangulation.get_used_vertices();
+      std::array<double, dim>  low, high;
+      low.fill(std::numeric_limits<double>::max());
+      high.fill(std::numeric_limits<double>::lowest());
+      for (unsigned int v = 0; v < vertices.size(); ++v)
+        if (used[v])
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            low[d]  = std::min(low[d], vertices[v][d]);
+            high[d] = std::max(high[d], vertices[v][d]);
+          }
+
+      std::map<std::array<double, dim>, unsigned int> on_faces;
+      for (unsigned int v = 0; v < vertices.size(); ++v)
+        if (used[v])
+        {
+          std::array<double, dim> x;
+          bool                    on_face = false;
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            x[d] = vertices[v][d];
+            on_face |= periodic[d] && (x[d] == low[d] || x[d] == high[d]);
+          }
+          if (on_face)
+            on_faces.emplace(x, v);
+        }
+
+      images.resize(vertices.size());
+      for (const auto &[x, v] : on_faces)
+        for (unsigned int directions = 1; directions < (1u << dim);
+             ++directions)
+        {
+          std::array<double, dim> image = x;
+          bool                    valid = true;
+          for (unsigned int d = 0; d < dim && valid; ++d)
+            if (directions & (1u << d))
+            {
+              valid    = periodic[d] && (x[d] == low[d] || x[d] == high[d]);
+              image[d] = x[d] == low[d] ? high[d] : low[d];
+            }
+          if (!valid)
+            continue;
+          const auto found = on_faces.find(image);
+          if (found != on_faces.end())
+            images[v].push_back(found->second);
+        }
+      return images;
+    }
+  } // namespace
+
+
   template <int dim>
   void
   Adaptivity<dim>::Parameters::declare_parameters(dealii::ParameterHandler &prm)
@@ -189,6 +269,8 @@ namespace ImmersedGrains
     };
     const auto vertex_cells = dealii::GridTools::vertex_to_cell_map(
       static_cast<const dealii::Triangulation<dim> &>(triangulation));
+    const auto periodic_images = periodic_vertex_images(
+      static_cast<const dealii::Triangulation<dim> &>(triangulation));
     // One layer beyond the band: cells there are kept, not coarsened, or
     // a parent coarsened next to the band would reach into it and be
     // refined again at the next adaptation, and so on.
@@ -205,12 +287,21 @@ namespace ImmersedGrains
           continue;
         bool near = false;
         for (unsigned int v = 0; v < cell->n_vertices() && !near; ++v)
-          for (const auto &other : vertex_cells[cell->vertex_index(v)])
+        {
+          const unsigned int vertex = cell->vertex_index(v);
+          for (const auto &other : vertex_cells[vertex])
             if ((near = is_marked(other)))
               break;
-        // Across a periodic face the cells share no vertex: the band
-        // continues through the face neighbours there (those across an
-        // edge or a corner of the periodic face are not counted).
+          // Across a periodic boundary the cells share no vertex, only
+          // its images.
+          if (!periodic_images.empty())
+            for (const unsigned int image : periodic_images[vertex])
+              for (const auto &other : vertex_cells[image])
+                if (!near && (near = is_marked(other)))
+                  break;
+        }
+        // And the cells across a periodic face itself, for a cell whose
+        // vertices there are all hanging (they have no image).
         for (const unsigned int f : cell->face_indices())
         {
           if (near || !cell->has_periodic_neighbor(f))
