@@ -19,7 +19,9 @@ def run_scene(prm_text, directory, ranks=1):
         prm.write(prm_text)
         prm.write("\nset Output directory = %s\n" % directory)
         prm.write("subsection Output\n  set Terminal output = quiet\nend\n")
-    command = [os.path.join(ROOT, "build", "immersed-grains"), prm.name]
+    # IMMERSED_GRAINS_BUILD: another build directory, to compare two builds.
+    build = os.environ.get("IMMERSED_GRAINS_BUILD", os.path.join(ROOT, "build"))
+    command = [os.path.join(build, "immersed-grains"), prm.name]
     if ranks > 1:
         command = ["mpirun", "-np", str(ranks)] + command
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1",
