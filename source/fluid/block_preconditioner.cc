@@ -4,6 +4,11 @@
 
 #include <immersed_grains/fluid/block_preconditioner.h>
 
+#include <Epetra_MultiVector.h>
+#include <Teuchos_ParameterList.hpp>
+
+#include <memory>
+
 namespace ImmersedGrains
 {
   BlockSchurPreconditioner::BlockSchurPreconditioner(
@@ -48,7 +53,17 @@ namespace ImmersedGrains
       // boundary, and without the overlap 2 ranks needed 34-51 iterations
       // where 1 needs 16-28 (doc/benchmarks.md, "On two ranks").
       data.smoother_overlap = 1;
-      velocity_amg.initialize(system_matrix.block(0, 0), data);
+      Teuchos::ParameterList              parameters;
+      std::unique_ptr<Epetra_MultiVector> constant_modes;
+      data.set_parameters(parameters,
+                          constant_modes,
+                          system_matrix.block(0, 0));
+      if (settings.velocity_coarse_gauss_seidel)
+      {
+        parameters.set("smoother: type", "symmetric Gauss-Seidel");
+        parameters.set("smoother: type (level 0)", "ILU");
+      }
+      velocity_amg.initialize(system_matrix.block(0, 0), parameters);
     }
     if (pressure_mass != nullptr)
     {

