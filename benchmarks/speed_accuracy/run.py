@@ -78,76 +78,101 @@ STRATEGIES = {
 }
 
 
-def run(name, end):
-    description, changes = STRATEGIES[name]
-    text = open(SCENE).read()
-    text += override("", "End time", end)
-    text += override("Output", "Write fields every", 0)
+def run(strategies, name, scene_text, work):
+    """Runs strategy @p name on @p scene_text (the scene with its end time
+    and output set) into WORK/name; returns its cost and the cloud's last
+    centroid (the last axis vertical) and horizontal extent."""
+    description, changes = strategies[name]
+    text = scene_text
     for section, entry, value in changes:
         text += override(section, entry, value)
-    directory = os.path.join(WORK, name)
+    directory = os.path.join(work, name)
     start = time.time()
     rows = run_scene(text, directory)
     wall = time.time() - start
     last = rows[-1]
+    axes = [a for a in "xyz" if "cloud_centroid_" + a in last]
     timings = read_csv(os.path.join(directory, "timings.csv"))
     setup = float(timings[0]["total"]) if timings else 0.0
     return dict(name=name, description=description, wall=wall,
                 run=wall - setup, steps=len(rows) - 1,
-                y0=float(rows[0]["cloud_centroid_y"]),
-                y=float(last["cloud_centroid_y"]),
-                x=float(last["cloud_centroid_x"]),
+                grains=int(float(last["particles"])),
+                start=[float(rows[0]["cloud_centroid_" + a]) for a in axes],
+                centroid=[float(last["cloud_centroid_" + a]) for a in axes],
                 width=float(last["cloud_extent_x"]),
                 time=float(last["time"]))
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--end", type=float, default=0.3)
+def study(strategies, scene, work, figure, title, default_end, options=(),
+          scene_changes=None):
+    """The command line of a cloud study: runs the strategies (or redraws
+    from results.json), writes the table and the Pareto figure. The error
+    is the centroid's distance from the reference's in percent of the
+    reference's vertical fall. @p options: more (flag, add_argument
+    keywords); @p scene_changes(args): parameter text they add to the
+    scene."""
+    parser = argparse.ArgumentParser(description=title)
+    parser.add_argument("--end", type=float, default=default_end)
     parser.add_argument("--only", default="")
-    parser.add_argument("--out", default=WORK)
+    parser.add_argument("--out", default=work)
     parser.add_argument("--plot-only", action="store_true",
                         help="redraw the table and figure from results.json")
+    for flag, keywords in options:
+        parser.add_argument(flag, **keywords)
     args = parser.parse_args()
-    names = args.only.split(",") if args.only else list(STRATEGIES)
+    names = args.only.split(",") if args.only else list(strategies)
     if "reference" not in names:
         names = ["reference"] + names
     os.makedirs(args.out, exist_ok=True)
     saved = os.path.join(args.out, "results.json")
     if args.plot_only:
         results = json.load(open(saved))
+        for r in results:  # written before the 3D study shared this code
+            if "centroid" not in r:
+                r.update(start=[r["x"], r["y0"]], centroid=[r["x"], r["y"]],
+                         grains=321)
     else:
+        text = open(scene).read()
+        text += override("", "End time", args.end)
+        text += override("Output", "Write fields every", 0)
+        if scene_changes:
+            text += scene_changes(args)
         results = []
         for name in names:
-            results.append(run(name, args.end))
+            results.append(run(strategies, name, text, args.out))
             print("ran %-16s %6.1f s" % (name, results[-1]["wall"]), flush=True)
-        json.dump(results, open(saved, "w"), indent=1)
+            json.dump(results, open(saved, "w"), indent=1)
     reference = results[0]
-    fallen = reference["y0"] - reference["y"]
+    fallen = reference["start"][-1] - reference["centroid"][-1]
     lines = ["| strategy | change | fluid steps | wall time after set-up s | "
              "centroid error, % of the fall | width error % |",
              "|---|---|---|---|---|---|"]
     for r in results:
-        dx, dy = r["x"] - reference["x"], r["y"] - reference["y"]
-        r["error"] = 100 * (dx * dx + dy * dy) ** 0.5 / fallen
+        d = [a - b for a, b in zip(r["centroid"], reference["centroid"])]
+        r["error"] = 100 * sum(c * c for c in d) ** 0.5 / fallen
         r["width_error"] = 100 * (r["width"] / reference["width"] - 1)
         lines.append("| %s | %s | %d | %.1f | %s | %s |" % (
             r["name"], r["description"], r["steps"], r["run"],
             "—" if r is reference else "%.3f" % r["error"],
             "—" if r is reference else "%+.2f" % r["width_error"]))
     lines.append("")
-    lines.append("Reference: the cloud fell %.4f mm by t = %.3f s, horizontal "
-                 "extent %.4f mm." % (1e3 * fallen, reference["time"],
-                                      1e3 * reference["width"]))
+    lines.append("Reference: %d grains; the cloud fell %.4f mm by t = %.3f s, "
+                 "horizontal extent %.4f mm." % (
+                     reference["grains"], 1e3 * fallen, reference["time"],
+                     1e3 * reference["width"]))
     table = "\n".join(lines) + "\n"
     print(table)
     with open(os.path.join(args.out, "table.md"), "w") as f:
         f.write(table)
-    plot_pareto(results, reference["run"],
-                os.path.join(args.out, "speed_accuracy_cloud_2d.png"),
-                "2D falling cloud to t = %.2f s: error against cost"
-                % reference["time"],
+    plot_pareto(results, reference["run"], os.path.join(args.out, figure),
+                "%s to t = %.2f s: error against cost" % (title,
+                                                          reference["time"]),
                 "centroid error [% of the distance fallen]")
+
+
+def main():
+    study(STRATEGIES, SCENE, WORK, "speed_accuracy_cloud_2d.png",
+          "2D falling cloud", 0.3)
 
 
 if __name__ == "__main__":
