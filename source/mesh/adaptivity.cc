@@ -285,35 +285,24 @@ namespace ImmersedGrains
         cell->get_dof_indices(index);
         if (marked[index[0]] != 0)
           continue;
+        // Cells touch through a shared vertex or, across a periodic
+        // boundary, through one of its images (with p4est's 2:1 balance
+        // across periodic faces every cell there has a vertex with one).
+        const auto touches_band = [&](const unsigned int vertex)
+        {
+          for (const auto &other : vertex_cells[vertex])
+            if (is_marked(other))
+              return true;
+          return false;
+        };
         bool near = false;
         for (unsigned int v = 0; v < cell->n_vertices() && !near; ++v)
         {
           const unsigned int vertex = cell->vertex_index(v);
-          for (const auto &other : vertex_cells[vertex])
-            if ((near = is_marked(other)))
-              break;
-          // Across a periodic boundary the cells share no vertex, only
-          // its images.
+          near                      = touches_band(vertex);
           if (!periodic_images.empty())
             for (const unsigned int image : periodic_images[vertex])
-              for (const auto &other : vertex_cells[image])
-                if (!near && (near = is_marked(other)))
-                  break;
-        }
-        // And the cells across a periodic face itself, for a cell whose
-        // vertices there are all hanging (they have no image).
-        for (const unsigned int f : cell->face_indices())
-        {
-          if (near || !cell->has_periodic_neighbor(f))
-            continue;
-          const auto neighbor = cell->periodic_neighbor(f);
-          if (!neighbor->has_children())
-            near = is_marked(neighbor);
-          else
-            for (unsigned int c = 0;
-                 c < dealii::GeometryInfo<dim>::max_children_per_face && !near;
-                 ++c)
-              near = is_marked(cell->periodic_neighbor_child_on_subface(f, c));
+              near = near || touches_band(image);
         }
         if (near)
           grow.push_back(index[0]);
