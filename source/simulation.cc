@@ -1298,7 +1298,11 @@ namespace ImmersedGrains
       double volume = 1;
       for (unsigned int d = 0; d < dim; ++d)
         volume *= geometry.upper_corner[d] - geometry.lower_corner[d];
-      const double fluid_volume = fluid->integrate_fluid_fraction();
+      // The coupling knows its fluid fraction node by node; prescribed
+      // fields are integrated by quadrature.
+      const double fluid_volume = coupling && coupling_parameters.two_way ?
+                                    coupling->fluid_volume() :
+                                    fluid->integrate_fluid_fraction();
       statistics.set("dofs", fluid->n_dofs());
       statistics.set("fluid_volume", fluid_volume);
       if (!pressure_drop_points.empty())

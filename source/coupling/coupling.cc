@@ -772,6 +772,14 @@ namespace ImmersedGrains
 
   template <int dim>
   double
+  Coupling<dim>::fluid_volume() const
+  {
+    return projection->fluid_volume();
+  }
+
+
+  template <int dim>
+  double
   Coupling<dim>::max_reynolds() const
   {
     return reynolds_max;

@@ -51,6 +51,7 @@ namespace ImmersedGrains
                                                        comm,
                                                        relevant);
     matrix.reinit(owned, owned, dsp, comm);
+    mass_matrix.reinit(owned, owned, dsp, comm);
 
     // M + l^2 K, and the row sums of M for the lumped variant.
     const dealii::QGauss<dim>                    quadrature(2);
@@ -62,15 +63,20 @@ namespace ImmersedGrains
                                       dealii::update_JxW_values);
     const unsigned int                           n = fe.n_dofs_per_cell();
     dealii::FullMatrix<double>                   cell_matrix(n, n);
+    dealii::FullMatrix<double>                   cell_mass(n, n);
     dealii::Vector<double>                       cell_lumped(n);
     std::vector<dealii::types::global_dof_index> indices(n);
     Vector                                       row_sums(owned, comm);
-    const double                                 l2 = length * length;
+    // Written on ghost DoFs too, then summed onto their owners.
+    Vector raw_integrals;
+    raw_integrals.reinit(owned, relevant, comm, true);
+    const double l2 = length * length;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
       {
         fe_values.reinit(cell);
         cell_matrix = 0;
+        cell_mass   = 0;
         cell_lumped = 0;
         for (unsigned int q = 0; q < quadrature.size(); ++q)
           for (unsigned int i = 0; i < n; ++i)
@@ -80,6 +86,7 @@ namespace ImmersedGrains
                                   fe_values.shape_value(j, q) *
                                   fe_values.JxW(q);
               cell_lumped(i) += mass;
+              cell_mass(i, j) += mass;
               if (!lumped)
                 cell_matrix(i, j) += mass;
               cell_matrix(i, j) +=
@@ -91,10 +98,17 @@ namespace ImmersedGrains
             cell_matrix(i, i) += cell_lumped(i);
         cell->get_dof_indices(indices);
         constraints.distribute_local_to_global(cell_matrix, indices, matrix);
+        constraints.distribute_local_to_global(cell_mass, indices, mass_matrix);
         constraints.distribute_local_to_global(cell_lumped, indices, row_sums);
+        for (unsigned int i = 0; i < n; ++i)
+          raw_integrals(indices[i]) += cell_lumped(i);
       }
     matrix.compress(dealii::VectorOperation::add);
+    mass_matrix.compress(dealii::VectorOperation::add);
     row_sums.compress(dealii::VectorOperation::add);
+    raw_integrals.compress(dealii::VectorOperation::add);
+    weights.reinit(owned, comm);
+    weights = raw_integrals;
 
     lumped_inverse.reinit(owned, comm);
     for (const auto i : owned)
@@ -136,6 +150,20 @@ namespace ImmersedGrains
 
   template <int dim>
   void
+  HelmholtzFilter<dim>::mass_product(const Vector &f, Vector &rhs) const
+  {
+    // The condensed matrix acts on the unconstrained values (its
+    // constrained columns are empty); its constrained rows hold only a
+    // diagonal, and their entries of a right-hand side are zero.
+    Vector owned_values(owned, triangulation.get_communicator());
+    owned_values = f;
+    mass_matrix.vmult(rhs, owned_values);
+    constraints.set_zero(rhs);
+  }
+
+
+  template <int dim>
+  void
   HelmholtzFilter<dim>::solve(const Vector &rhs, Vector &ghosted) const
   {
     Vector x(owned, triangulation.get_communicator());
@@ -172,23 +200,17 @@ namespace ImmersedGrains
   double
   HelmholtzFilter<dim>::integral(const Vector &f) const
   {
-    const dealii::QGauss<dim> quadrature(2);
-    dealii::FEValues<dim>     fe_values(mapping,
-                                    fe,
-                                    quadrature,
-                                    dealii::update_values |
-                                      dealii::update_JxW_values);
-    std::vector<double>       values(quadrature.size());
-    double                    sum = 0;
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-      {
-        fe_values.reinit(cell);
-        fe_values.get_function_values(f, values);
-        for (unsigned int q = 0; q < quadrature.size(); ++q)
-          sum += values[q] * fe_values.JxW(q);
-      }
-    return dealii::Utilities::MPI::sum(sum, triangulation.get_communicator());
+    Vector owned_values(owned, triangulation.get_communicator());
+    owned_values = f;
+    return weights * owned_values; // summed over ranks
+  }
+
+
+  template <int dim>
+  const typename HelmholtzFilter<dim>::Vector &
+  HelmholtzFilter<dim>::shape_integrals() const
+  {
+    return weights;
   }
 
 

@@ -146,30 +146,9 @@ namespace ImmersedGrains
 
     if (parameters.smoothing_length > 0)
     {
-      // (N_j, phi_s): the filter's mass matrix, consistent, applied cell
-      // by cell.
-      auto                      felt_rhs = filter.make_owned_vector();
-      const dealii::QGauss<dim> quadrature(2);
-      dealii::FEValues<dim>     fe_values(filter.get_mapping(),
-                                      fe,
-                                      quadrature,
-                                      dealii::update_values |
-                                        dealii::update_JxW_values);
-      std::vector<double>       values(quadrature.size());
-      dealii::Vector<double>    cell_rhs(n);
-      for (const auto &cell : filter.get_dof_handler().active_cell_iterators())
-        if (cell->is_locally_owned())
-        {
-          fe_values.reinit(cell);
-          fe_values.get_function_values(fraction, values);
-          cell_rhs = 0;
-          for (unsigned int q = 0; q < quadrature.size(); ++q)
-            for (unsigned int j = 0; j < n; ++j)
-              cell_rhs(j) +=
-                values[q] * fe_values.shape_value(j, q) * fe_values.JxW(q);
-          filter.add_cell_contribution(cell, cell_rhs, indices, felt_rhs);
-        }
-      felt_rhs.compress(dealii::VectorOperation::add);
+      // (N_j, phi_s): the filter's consistent mass matrix applied.
+      auto felt_rhs = filter.make_owned_vector();
+      filter.mass_product(fraction, felt_rhs);
       filter.solve(felt_rhs, felt);
     }
 
@@ -189,6 +168,23 @@ namespace ImmersedGrains
   SolidFraction<dim>::integral() const
   {
     return filter.integral(fraction);
+  }
+
+
+  template <int dim>
+  double
+  SolidFraction<dim>::fluid_volume() const
+  {
+    // phi is the Q1 field of the clamped node values (evaluate()), so its
+    // integral is exact node by node.
+    const auto &weights = filter.shape_integrals();
+    auto        solid   = filter.make_owned_vector();
+    solid               = fraction;
+    double sum          = 0;
+    for (unsigned int k = 0; k < solid.locally_owned_size(); ++k)
+      sum += weights.begin()[k] * clamped_fluid_fraction(solid.begin()[k]);
+    return dealii::Utilities::MPI::sum(
+      sum, filter.get_dof_handler().get_communicator());
   }
 
 

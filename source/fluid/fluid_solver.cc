@@ -364,6 +364,43 @@ namespace ImmersedGrains
                          system_rhs);
     cell_gather = std::make_unique<CellGather<dim>>();
     cell_gather->reinit(dof_handler, solution);
+
+    {
+      // Every pressure DoF's own integral, hanging ones included: the
+      // pressure vectors hold their distributed values, and the mean is
+      // taken over what the cells see.
+      dealii::TrilinosWrappers::MPI::Vector integrals;
+      integrals.reinit(owned_partitioning[1],
+                       relevant_partitioning[1],
+                       mpi_communicator,
+                       true);
+      const dealii::QGauss<dim>                    quadrature(fe.degree + 1);
+      dealii::FEValues<dim>                        fe_values(mapping,
+                                      fe,
+                                      quadrature,
+                                      dealii::update_values |
+                                        dealii::update_JxW_values);
+      std::vector<dealii::types::global_dof_index> indices(
+        fe.n_dofs_per_cell());
+      double measure = 0;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          cell->get_dof_indices(indices);
+          for (unsigned int q = 0; q < quadrature.size(); ++q)
+            measure += fe_values.JxW(q);
+          for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+            if (fe.system_to_component_index(i).first == dim)
+              for (unsigned int q = 0; q < quadrature.size(); ++q)
+                integrals(indices[i] - n_u) +=
+                  fe_values.shape_value(i, q) * fe_values.JxW(q);
+        }
+      integrals.compress(dealii::VectorOperation::add);
+      pressure_shape_integrals.reinit(owned_partitioning[1], mpi_communicator);
+      pressure_shape_integrals = integrals;
+      domain_measure = dealii::Utilities::MPI::sum(measure, mpi_communicator);
+    }
     pcout << "  fluid: "
           << dealii::Utilities::MPI::min(cell_scatter->direct_fraction(),
                                          mpi_communicator) *
@@ -478,12 +515,8 @@ namespace ImmersedGrains
   {
     if (!pressure_has_null_space())
       return;
-    VectorType ghosted(owned_partitioning,
-                       relevant_partitioning,
-                       mpi_communicator);
-    ghosted           = vector;
-    const double mean = dealii::VectorTools::compute_mean_value(
-      mapping, dof_handler, dealii::QGauss<dim>(3), ghosted, dim);
+    const double mean =
+      (pressure_shape_integrals * vector.block(1)) / domain_measure;
     vector.block(1).add(-mean);
   }
 

@@ -155,6 +155,10 @@ namespace ImmersedGrains
     double
     solid_volume() const;
 
+    /** Integral of the fluid fraction the fluid sees (evaluate()). */
+    double
+    fluid_volume() const;
+
     /** Largest particle Reynolds number of the last step (global). */
     double
     max_reynolds() const;

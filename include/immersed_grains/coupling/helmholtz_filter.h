@@ -62,6 +62,13 @@ namespace ImmersedGrains
       std::vector<dealii::types::global_dof_index>                 &indices,
       Vector                                                       &rhs) const;
 
+    /**
+     * (N_j, f) for a ghosted field @p f into the owned @p rhs, through the
+     * constraints (the consistent mass matrix applied to f).
+     */
+    void
+    mass_product(const Vector &f, Vector &rhs) const;
+
     /** Solves A f = @p rhs (compressed, owned) into the ghosted @p f. */
     void
     solve(const Vector &rhs, Vector &f) const;
@@ -74,6 +81,17 @@ namespace ImmersedGrains
     /** Integral of a ghosted field over the locally owned cells, summed. */
     double
     integral(const Vector &f) const;
+
+    /**
+     * The integral of each shape function over the locally owned cells,
+     * every DoF's own (hanging and periodic ones included, not condensed),
+     * summed over ranks onto the owners: the integral of a ghosted field f
+     * whose constrained entries are distributed is the sum over owned DoFs
+     * of weights_i g(f_i) for any g applied node by node (g = identity:
+     * integral()).
+     */
+    const Vector &
+    shape_integrals() const;
 
     const dealii::DoFHandler<dim> &
     get_dof_handler() const;
@@ -96,7 +114,9 @@ namespace ImmersedGrains
     dealii::AffineConstraints<double>                        constraints;
     dealii::IndexSet                                         owned, relevant;
     dealii::TrilinosWrappers::SparseMatrix                   matrix;
+    dealii::TrilinosWrappers::SparseMatrix                   mass_matrix;
     Vector                                                   lumped_inverse;
+    Vector                                                   weights;
     // A plain lumped projection is a division, not a linear solve.
     bool diagonal = false;
   };

@@ -90,6 +90,13 @@ namespace ImmersedGrains
     double
     integral() const;
 
+    /**
+     * Integral of the fluid fraction phi the mixture sees (evaluate():
+     * clamped node by node), from the filter's shape integrals.
+     */
+    double
+    fluid_volume() const;
+
     /** Number of Q1 nodes where phi was clamped to the minimum. */
     unsigned int
     n_clamped() const;

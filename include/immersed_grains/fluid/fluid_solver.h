@@ -296,7 +296,12 @@ namespace ImmersedGrains
     // Diagonal of the mass-and-drag part of the velocity block plus its
     // floor where that vanishes (schur_floor_factor, fluid_assembly.cc),
     // and the Schur complement approximation B diag^{-1} B^T built from it.
-    VectorType                             reaction_diagonal; // block 0 used
+    VectorType reaction_diagonal; // block 0 used
+    // The integral of each pressure shape function (block-local indices,
+    // summed onto the owners) and of 1: the pressure's mean is a dot
+    // product, not a pass over the cells (normalize_pressure()).
+    dealii::TrilinosWrappers::MPI::Vector  pressure_shape_integrals;
+    double                                 domain_measure = 0;
     dealii::TrilinosWrappers::SparseMatrix schur_diagonal_matrix;
 
     VectorType solution;         // ghosted, current iterate / new time
