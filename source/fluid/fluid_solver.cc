@@ -116,7 +116,6 @@ namespace ImmersedGrains
       , dof_handler(triangulation)
       , velocity_shapes(fe.base_element(0))
       , pressure_shapes(fe.base_element(1))
-      , mean_shapes(fe.base_element(0))
       , forcing(
           [&]() -> std::shared_ptr<dealii::Function<dim>>
           {
@@ -129,6 +128,15 @@ namespace ImmersedGrains
           }())
       , boundary_velocity(parameters.boundary_velocity)
   {
+    {
+      const dealii::QGauss<dim> quadrature(fe.degree + 1);
+      const auto               &scalar = fe.base_element(0);
+      cell_mean_weights.assign(scalar.n_dofs_per_cell(), 0.0);
+      for (unsigned int i = 0; i < scalar.n_dofs_per_cell(); ++i)
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          cell_mean_weights[i] +=
+            quadrature.weight(q) * scalar.shape_value(i, quadrature.point(q));
+    }
     if (parameters.forcing_is_constant)
     {
       dealii::Vector<double> value(dim);
@@ -206,24 +214,15 @@ namespace ImmersedGrains
     if (cell_averaged_drag)
     {
       // The cell-mean velocity, the one the averaged drag is felt against.
-      const dealii::QGauss<dim> quadrature(fe.degree + 1);
-      mean_shapes.reinit(cell, quadrature.get_points(), true);
       dealii::Tensor<1, dim> mean;
-      double                 volume = 0;
-      for (unsigned int q = 0; q < quadrature.size(); ++q)
+      for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
       {
-        const double JxW =
-          quadrature.weight(q) * mean_shapes.jacobian_determinant(q);
-        volume += JxW;
-        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
-        {
-          const auto [component, index] = fe.system_to_component_index(i);
-          if (component < dim)
-            mean[component] += local[i] * mean_shapes.value(index, q) * JxW;
-        }
+        const auto [component, index] = fe.system_to_component_index(i);
+        if (component < dim)
+          mean[component] += local[i] * cell_mean_weights[index];
       }
       for (auto &v : values)
-        v.velocity = mean / volume;
+        v.velocity = mean;
     }
     return values;
   }

@@ -312,7 +312,10 @@ namespace ImmersedGrains
 
     // Shape functions at grain positions (point_values); the Q2 ones also at
     // the Gauss points for cell means.
-    mutable CellPointShapes<dim> velocity_shapes, pressure_shapes, mean_shapes;
+    mutable CellPointShapes<dim> velocity_shapes, pressure_shapes;
+    // The cell mean of each scalar velocity shape function: the same on
+    // every cell, all of them being axis-parallel boxes (the mapping).
+    std::vector<double> cell_mean_weights;
 
     std::shared_ptr<const MixtureFields<dim>>   mixture_fields;
     std::shared_ptr<const PointDragSource<dim>> point_drag_source;
