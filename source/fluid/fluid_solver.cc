@@ -195,35 +195,32 @@ namespace ImmersedGrains
         local[i] = solution(indices[i]);
     }
     // The scalar Q2 (velocity) and Q1 (pressure) functions at the points:
-    // one pass over each, no FEValues set up per call.
-    velocity_shapes.reinit(cell, reference_locations, false);
+    // one pass over each, no FEValues set up per call. With the cell drag
+    // the velocity is the cell mean, the same at every point.
+    const bool at_points = !cell_averaged_drag;
+    if (at_points)
+      velocity_shapes.reinit(cell, reference_locations, false);
     pressure_shapes.reinit(cell, reference_locations, true);
     std::vector<PointValues> values(reference_locations.size());
+    dealii::Tensor<1, dim>   mean;
     for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
     {
       const double coefficient      = local[i];
       const auto [component, index] = fe.system_to_component_index(i);
-      for (unsigned int q = 0; q < values.size(); ++q)
-        if (component < dim)
-          values[q].velocity[component] +=
-            coefficient * velocity_shapes.value(index, q);
-        else
+      if (component == dim)
+        for (unsigned int q = 0; q < values.size(); ++q)
           values[q].pressure_gradient +=
             coefficient * pressure_shapes.gradient(index, q);
+      else if (at_points)
+        for (unsigned int q = 0; q < values.size(); ++q)
+          values[q].velocity[component] +=
+            coefficient * velocity_shapes.value(index, q);
+      else
+        mean[component] += coefficient * cell_mean_weights[index];
     }
-    if (cell_averaged_drag)
-    {
-      // The cell-mean velocity, the one the averaged drag is felt against.
-      dealii::Tensor<1, dim> mean;
-      for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
-      {
-        const auto [component, index] = fe.system_to_component_index(i);
-        if (component < dim)
-          mean[component] += local[i] * cell_mean_weights[index];
-      }
+    if (!at_points)
       for (auto &v : values)
         v.velocity = mean;
-    }
     return values;
   }
 
