@@ -7,12 +7,46 @@
 
 namespace ImmersedGrains
 {
+  namespace
+  {
+    // What AffineConstraints puts on a constrained row's diagonal where the
+    // cell matrix's own entry is zero: the mean absolute diagonal, else
+    // the l1 norm over the rows, else 1.
+    double
+    mean_absolute_diagonal(const dealii::FullMatrix<double> &cell_matrix)
+    {
+      double mean = 0;
+      for (unsigned int i = 0; i < cell_matrix.m(); ++i)
+        mean += std::abs(cell_matrix(i, i));
+      mean /= cell_matrix.m();
+      if (mean == 0)
+      {
+        mean = cell_matrix.l1_norm() / cell_matrix.m();
+        if (mean == 0)
+          mean = 1;
+      }
+      return mean;
+    }
+  } // namespace
+
+
   template <int dim>
   void
   CellScatter<dim>::clear()
   {
     pairs.clear();
     direct_index.clear();
+    condensed_index.clear();
+    condensed_targets_start.clear();
+    condensed_entries_start.clear();
+    condensed_expansion_start.clear();
+    condensed_diagonals_start.clear();
+    condensed_targets.clear();
+    condensed_expansion_offsets.clear();
+    condensed_expansion.clear();
+    condensed_diagonals.clear();
+    condensed_row_lengths.clear();
+    condensed_entries.clear();
     rows.clear();
     fixed.clear();
     positions.clear();
@@ -28,7 +62,8 @@ namespace ImmersedGrains
   bool
   CellScatter<dim>::is_direct(const unsigned int k) const
   {
-    return k < direct_index.size() && direct_index[k] >= 0;
+    return k < direct_index.size() &&
+           (direct_index[k] >= 0 || condensed_index[k] >= 0);
   }
 
 
@@ -38,10 +73,10 @@ namespace ImmersedGrains
   {
     if (direct_index.empty())
       return 0;
-    return static_cast<double>(std::count_if(direct_index.begin(),
-                                             direct_index.end(),
-                                             [](int d) { return d >= 0; })) /
-           direct_index.size();
+    unsigned int direct = 0;
+    for (unsigned int k = 0; k < direct_index.size(); ++k)
+      direct += is_direct(k) ? 1 : 0;
+    return static_cast<double>(direct) / direct_index.size();
   }
 
 
@@ -103,8 +138,12 @@ namespace ImmersedGrains
 
     // The coupled pairs; the velocity block is 0, the pressure block 1.
     dof_block.resize(dofs_per_cell);
+    component_of.resize(dofs_per_cell);
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
-      dof_block[i] = fe.system_to_component_index(i).first < dim ? 0 : 1;
+    {
+      component_of[i] = fe.system_to_component_index(i).first;
+      dof_block[i]    = component_of[i] < dim ? 0 : 1;
+    }
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       for (unsigned int j = 0; j < dofs_per_cell; ++j)
         if (coupling(fe.system_to_component_index(i).first,
@@ -178,10 +217,171 @@ namespace ImmersedGrains
         positions.insert(positions.end(),
                          cell_positions.begin(),
                          cell_positions.end());
+        condensed_index.push_back(-1);
       }
       else
+      {
         direct_index.push_back(-1);
+        condensed_index.push_back(
+          add_condensed_cell(
+            dofs, constraints, coupling, matrix, row_indices, row_lengths) ?
+            static_cast<int>(condensed_targets_start.size()) - 1 :
+            -1);
+      }
     }
+  }
+
+
+  template <int dim>
+  bool
+  CellScatter<dim>::add_condensed_cell(
+    const std::vector<dealii::types::global_dof_index>     &dofs,
+    const dealii::AffineConstraints<double>                &constraints,
+    const dealii::Table<2, dealii::DoFTools::Coupling>     &coupling,
+    const MatrixType                                       &matrix,
+    const std::array<std::array<std::vector<int *>, 2>, 2> &row_indices,
+    const std::array<std::array<std::vector<int>, 2>, 2>   &row_lengths)
+  {
+    const auto &blocks = matrix.get_row_indices();
+    // The position of column @p dof in the row @p row of block (b, c), or
+    // skip where it is absent.
+    const auto position = [&](const unsigned int                    b,
+                              const int                             row,
+                              const dealii::types::global_dof_index dof)
+    {
+      const auto [c, index] = blocks.global_to_local(dof);
+      const int column      = matrix.block(b, c).trilinos_matrix().ColMap().LID(
+        static_cast<dealii::TrilinosWrappers::types::int_type>(index));
+      const int *begin = row_indices[b][c][row];
+      const int *end   = begin + row_lengths[b][c][row];
+      const int *found = std::lower_bound(begin, end, column);
+      return column >= 0 && found != end && *found == column &&
+                 found - begin < skip ?
+               static_cast<std::uint16_t>(found - begin) :
+               skip;
+    };
+    // The owned row of @p dof in its diagonal block, or -1.
+    const auto owned_row = [&](const dealii::types::global_dof_index dof)
+    {
+      const auto [block, index] = blocks.global_to_local(dof);
+      return matrix.block(block, block)
+        .trilinos_matrix()
+        .RowMap()
+        .LID(static_cast<dealii::TrilinosWrappers::types::int_type>(index));
+    };
+
+    std::vector<dealii::types::global_dof_index> target_dofs;
+    std::vector<Target>                          targets;
+    std::vector<std::vector<Expansion>>          expansion(dofs_per_cell);
+    std::vector<Diagonal>                        diagonals;
+    const auto                                  &fe_blocks = dof_block;
+    // The index of @p dof among the targets, added if new; -1 if its row
+    // is not owned here or lies in another block than @p block.
+    const auto target_of = [&](const dealii::types::global_dof_index dof,
+                               const unsigned int                    block,
+                               const unsigned int component) -> int
+    {
+      const auto known = std::find(target_dofs.begin(), target_dofs.end(), dof);
+      if (known != target_dofs.end())
+        return known - target_dofs.begin();
+      const int row = owned_row(dof);
+      if (row < 0 || blocks.global_to_local(dof).first != block ||
+          target_dofs.size() + 1 >= skip)
+        return -1;
+      target_dofs.push_back(dof);
+      targets.push_back({row,
+                         static_cast<std::uint8_t>(block),
+                         static_cast<std::uint16_t>(component)});
+      return targets.size() - 1;
+    };
+
+    for (unsigned int i = 0; i < dofs_per_cell; ++i)
+    {
+      const unsigned int block     = fe_blocks[i];
+      const unsigned int component = component_of[i];
+      if (!constraints.is_constrained(dofs[i]))
+      {
+        const int t = target_of(dofs[i], block, component);
+        if (t < 0)
+          return false;
+        expansion[i].push_back({static_cast<std::uint16_t>(t), 1.0});
+        continue;
+      }
+      if (constraints.is_inhomogeneously_constrained(dofs[i]))
+        return false;
+      for (const auto &[master, weight] :
+           *constraints.get_constraint_entries(dofs[i]))
+      {
+        const int t = target_of(master, block, component);
+        if (t < 0)
+          return false;
+        expansion[i].push_back({static_cast<std::uint16_t>(t), weight});
+      }
+      const int row = owned_row(dofs[i]);
+      if (row < 0 || blocks.global_to_local(dofs[i]).first != block)
+        return false;
+      const std::uint16_t diagonal = position(block, row, dofs[i]);
+      if (diagonal == skip)
+        return false;
+      diagonals.push_back({static_cast<std::uint16_t>(i), diagonal, row});
+    }
+
+    // Each target's column in the blocks of both row blocks, looked up
+    // once (Epetra's column maps hash the global index).
+    std::array<std::vector<int>, 2> columns;
+    for (unsigned int row_block = 0; row_block < 2; ++row_block)
+      for (unsigned int t = 0; t < targets.size(); ++t)
+        columns[row_block].push_back(
+          matrix.block(row_block, targets[t].block)
+            .trilinos_matrix()
+            .ColMap()
+            .LID(static_cast<dealii::TrilinosWrappers::types::int_type>(
+              blocks.global_to_local(target_dofs[t]).second)));
+    std::vector<std::uint16_t> lengths(targets.size(), 0);
+    std::vector<Entry>         entries;
+    for (unsigned int a = 0; a < targets.size(); ++a)
+      for (unsigned int b = 0; b < targets.size(); ++b)
+        if (coupling(targets[a].component, targets[b].component) !=
+            dealii::DoFTools::none)
+        {
+          const unsigned int row_block = targets[a].block;
+          const int          column    = columns[row_block][b];
+          const int         *begin =
+            row_indices[row_block][targets[b].block][targets[a].row];
+          const int *end =
+            begin + row_lengths[row_block][targets[b].block][targets[a].row];
+          const int *found = std::lower_bound(begin, end, column);
+          if (column < 0 || found == end || *found != column ||
+              found - begin >= skip)
+            return false;
+          entries.push_back({static_cast<std::uint16_t>(b),
+                             static_cast<std::uint16_t>(found - begin)});
+          ++lengths[a];
+        }
+
+    condensed_targets_start.push_back(condensed_targets.size());
+    condensed_targets.insert(condensed_targets.end(),
+                             targets.begin(),
+                             targets.end());
+    condensed_row_lengths.insert(condensed_row_lengths.end(),
+                                 lengths.begin(),
+                                 lengths.end());
+    condensed_entries_start.push_back(condensed_entries.size());
+    condensed_entries.insert(condensed_entries.end(),
+                             entries.begin(),
+                             entries.end());
+    condensed_expansion_start.push_back(condensed_expansion_offsets.size());
+    for (const auto &e : expansion)
+    {
+      condensed_expansion_offsets.push_back(condensed_expansion.size());
+      condensed_expansion.insert(condensed_expansion.end(), e.begin(), e.end());
+    }
+    condensed_expansion_offsets.push_back(condensed_expansion.size());
+    condensed_diagonals_start.push_back(condensed_diagonals.size());
+    condensed_diagonals.insert(condensed_diagonals.end(),
+                               diagonals.begin(),
+                               diagonals.end());
+    return true;
   }
 
 
@@ -192,6 +392,11 @@ namespace ImmersedGrains
                         const dealii::Vector<double>     &cell_rhs) const
   {
     Assert(is_direct(k), dealii::ExcInternalError());
+    if (direct_index[k] < 0)
+    {
+      add_condensed(condensed_index[k], cell_matrix, cell_rhs);
+      return;
+    }
     const std::size_t    d          = direct_index[k];
     const int           *cell_rows  = &rows[d * dofs_per_cell];
     const std::size_t    first_dof  = d * dofs_per_cell;
@@ -203,19 +408,8 @@ namespace ImmersedGrains
     bool any_fixed = false;
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       any_fixed = any_fixed || fixed[first_dof + i];
-    double mean_diagonal = 0;
-    if (any_fixed)
-    {
-      for (unsigned int i = 0; i < dofs_per_cell; ++i)
-        mean_diagonal += std::abs(cell_matrix(i, i));
-      mean_diagonal /= dofs_per_cell;
-      if (mean_diagonal == 0)
-      {
-        mean_diagonal = cell_matrix.l1_norm() / dofs_per_cell;
-        if (mean_diagonal == 0)
-          mean_diagonal = 1;
-      }
-    }
+    const double mean_diagonal =
+      any_fixed ? mean_absolute_diagonal(cell_matrix) : 0.0;
 
     // Each local row's values in the two column blocks, looked up once
     // per cell rather than once per entry.
@@ -238,6 +432,79 @@ namespace ImmersedGrains
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       if (!fixed[first_dof + i])
         vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
+  }
+
+
+  template <int dim>
+  void
+  CellScatter<dim>::add_condensed(const unsigned int                c,
+                                  const dealii::FullMatrix<double> &cell_matrix,
+                                  const dealii::Vector<double> &cell_rhs) const
+  {
+    const Target     *targets = &condensed_targets[condensed_targets_start[c]];
+    const std::size_t n_targets =
+      (c + 1 < condensed_targets_start.size() ? condensed_targets_start[c + 1] :
+                                                condensed_targets.size()) -
+      condensed_targets_start[c];
+    const unsigned int *offsets =
+      &condensed_expansion_offsets[condensed_expansion_start[c]];
+
+    // C^T K C and C^T f in the cell, over its target rows.
+    condensed_matrix.assign(n_targets * n_targets, 0.0);
+    condensed_rhs.assign(n_targets, 0.0);
+    for (const Pair &pair : pairs)
+    {
+      const double value = cell_matrix(pair.i, pair.j);
+      if (value == 0)
+        continue;
+      for (unsigned int e = offsets[pair.i]; e < offsets[pair.i + 1]; ++e)
+      {
+        const Expansion &row    = condensed_expansion[e];
+        double          *target = &condensed_matrix[row.target * n_targets];
+        for (unsigned int f = offsets[pair.j]; f < offsets[pair.j + 1]; ++f)
+        {
+          const Expansion &column = condensed_expansion[f];
+          target[column.target] += row.weight * column.weight * value;
+        }
+      }
+    }
+    for (unsigned int i = 0; i < dofs_per_cell; ++i)
+      for (unsigned int e = offsets[i]; e < offsets[i + 1]; ++e)
+        condensed_rhs[condensed_expansion[e].target] +=
+          condensed_expansion[e].weight * cell_rhs(i);
+
+    const Entry         *entry = &condensed_entries[condensed_entries_start[c]];
+    const std::uint16_t *lengths =
+      &condensed_row_lengths[condensed_targets_start[c]];
+    for (std::size_t a = 0; a < n_targets; ++a)
+    {
+      const Target &row       = targets[a];
+      double *const values[2] = {row_values[row.block][0][row.row],
+                                 row_values[row.block][1][row.row]};
+      const double *sums      = &condensed_matrix[a * n_targets];
+      for (unsigned int k = 0; k < lengths[a]; ++k, ++entry)
+        values[targets[entry->column].block][entry->position] +=
+          sums[entry->column];
+      vector_values[row.block][row.row] += condensed_rhs[a];
+    }
+
+    // The constrained rows' diagonal, as AffineConstraints sets it.
+    const std::size_t first = condensed_diagonals_start[c];
+    const std::size_t last  = c + 1 < condensed_diagonals_start.size() ?
+                                condensed_diagonals_start[c + 1] :
+                                condensed_diagonals.size();
+    if (first == last)
+      return;
+    const double mean = mean_absolute_diagonal(cell_matrix);
+    for (std::size_t d = first; d < last; ++d)
+    {
+      const Diagonal    &diagonal = condensed_diagonals[d];
+      const unsigned int block    = dof_block[diagonal.local_dof];
+      const double       value =
+        std::abs(cell_matrix(diagonal.local_dof, diagonal.local_dof));
+      row_values[block][block][diagonal.row][diagonal.position] +=
+        value != 0 ? value : mean;
+    }
   }
 
 

@@ -30,9 +30,17 @@ namespace ImmersedGrains
    * adds the free rows' entries in free columns, the absolute diagonal
    * entry (or the mean absolute diagonal where it is zero) on each fixed
    * row, and nothing else, which add() repeats entry by entry in the same
-   * order, so that the assembled system is the same to the last bit. Cells
-   * with hanging nodes, periodic or inhomogeneous constraints, or DoFs of
-   * other ranks, keep the general path.
+   * order, so that the assembled system is the same to the last bit.
+   *
+   * A cell with hanging-node or periodic constraints qualifies too when
+   * every row it writes (its free DoFs, the masters of its constrained
+   * ones, and the constrained ones' own diagonals) is owned by this rank:
+   * its matrix is condensed in the cell, C^T K C with C the constraints'
+   * weights from the cell's DoFs to those rows, and added at positions
+   * found once per mesh; the constrained rows get the diagonal entry
+   * AffineConstraints gives them. The sums are the same as
+   * distribute_local_to_global's, in another order (round-off). Cells with
+   * inhomogeneous constraints or rows of other ranks keep the general path.
    */
   template <int dim>
   class CellScatter
@@ -87,6 +95,61 @@ namespace ImmersedGrains
 
     // Per locally owned cell: its number among the direct cells, or -1.
     std::vector<int> direct_index;
+    // Per locally owned cell: its number among the condensed cells, or -1.
+    std::vector<int> condensed_index;
+
+    // The condensed cells (hanging nodes, periodicity). Per cell: its
+    // target rows (the rows it writes: free DoFs and masters), each with
+    // block, Epetra row and component; each local DoF's targets with
+    // weights; each constrained local DoF's own row and the position of
+    // its diagonal; and, target row by target row, the coupled target
+    // columns with their positions. Offsets per cell into flat arrays.
+    struct Target
+    {
+      int           row;
+      std::uint8_t  block;
+      std::uint16_t component;
+    };
+    struct Expansion
+    {
+      std::uint16_t target;
+      double        weight;
+    };
+    struct Diagonal
+    {
+      std::uint16_t local_dof;
+      std::uint16_t position;
+      int           row;
+    };
+    struct Entry
+    {
+      std::uint16_t column; // target index
+      std::uint16_t position;
+    };
+    std::vector<std::size_t> condensed_targets_start, condensed_entries_start,
+      condensed_expansion_start, condensed_diagonals_start;
+    std::vector<Target>        condensed_targets;
+    std::vector<unsigned int>  condensed_expansion_offsets; // dofs + 1 per cell
+    std::vector<Expansion>     condensed_expansion;
+    std::vector<Diagonal>      condensed_diagonals;
+    std::vector<std::uint16_t> condensed_row_lengths; // entries per target row
+    std::vector<Entry>         condensed_entries;
+    mutable std::vector<double> condensed_matrix, condensed_rhs;
+
+    // Records a cell for the condensed path; false if it does not qualify.
+    bool
+    add_condensed_cell(
+      const std::vector<dealii::types::global_dof_index>     &dofs,
+      const dealii::AffineConstraints<double>                &constraints,
+      const dealii::Table<2, dealii::DoFTools::Coupling>     &coupling,
+      const MatrixType                                       &matrix,
+      const std::array<std::array<std::vector<int *>, 2>, 2> &row_indices,
+      const std::array<std::array<std::vector<int>, 2>, 2>   &row_lengths);
+
+    void
+    add_condensed(unsigned int                      c,
+                  const dealii::FullMatrix<double> &cell_matrix,
+                  const dealii::Vector<double>     &cell_rhs) const;
     // Per direct cell: each local DoF's row in its block (Epetra's local
     // numbering) with a flag for a fixed DoF, and each pair's position in
     // that row (skip where the pair does not enter the matrix).
@@ -94,8 +157,9 @@ namespace ImmersedGrains
     std::vector<bool>          fixed;
     std::vector<std::uint16_t> positions;
 
-    // Local DoF -> block of its row.
-    std::vector<std::uint8_t> dof_block;
+    // Local DoF -> block of its row, and its component.
+    std::vector<std::uint8_t>  dof_block;
+    std::vector<std::uint16_t> component_of;
     // The values of each local row of each block, and of each vector block.
     std::array<std::array<std::vector<double *>, 2>, 2> row_values;
     std::array<double *, 2>                             vector_values{};
