@@ -274,7 +274,6 @@ namespace ImmersedGrains
     std::vector<Target>                          targets;
     std::vector<std::vector<Expansion>>          expansion(dofs_per_cell);
     std::vector<Diagonal>                        diagonals;
-    const auto                                  &fe_blocks = dof_block;
     // The index of @p dof among the targets, added if new; -1 if its row
     // is not owned here or lies in another block than @p block.
     const auto target_of = [&](const dealii::types::global_dof_index dof,
@@ -297,7 +296,7 @@ namespace ImmersedGrains
 
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
     {
-      const unsigned int block     = fe_blocks[i];
+      const unsigned int block     = dof_block[i];
       const unsigned int component = component_of[i];
       if (!constraints.is_constrained(dofs[i]))
       {
