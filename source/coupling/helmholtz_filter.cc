@@ -25,7 +25,9 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  HelmholtzFilter<dim>::setup(const bool lumped, const double length)
+  HelmholtzFilter<dim>::setup(const bool   lumped,
+                              const double length,
+                              const bool   with_mass_matrix)
   {
     const MPI_Comm comm = triangulation.get_communicator();
     dof_handler.distribute_dofs(fe);
@@ -51,7 +53,10 @@ namespace ImmersedGrains
                                                        comm,
                                                        relevant);
     matrix.reinit(owned, owned, dsp, comm);
-    mass_matrix.reinit(owned, owned, dsp, comm);
+    if (with_mass_matrix)
+      mass_matrix.reinit(owned, owned, dsp, comm);
+    else
+      mass_matrix.clear();
 
     // M + l^2 K, and the row sums of M for the lumped variant.
     const dealii::QGauss<dim>                    quadrature(2);
@@ -98,13 +103,17 @@ namespace ImmersedGrains
             cell_matrix(i, i) += cell_lumped(i);
         cell->get_dof_indices(indices);
         constraints.distribute_local_to_global(cell_matrix, indices, matrix);
-        constraints.distribute_local_to_global(cell_mass, indices, mass_matrix);
+        if (with_mass_matrix)
+          constraints.distribute_local_to_global(cell_mass,
+                                                 indices,
+                                                 mass_matrix);
         constraints.distribute_local_to_global(cell_lumped, indices, row_sums);
         for (unsigned int i = 0; i < n; ++i)
           raw_integrals(indices[i]) += cell_lumped(i);
       }
     matrix.compress(dealii::VectorOperation::add);
-    mass_matrix.compress(dealii::VectorOperation::add);
+    if (with_mass_matrix)
+      mass_matrix.compress(dealii::VectorOperation::add);
     row_sums.compress(dealii::VectorOperation::add);
     raw_integrals.compress(dealii::VectorOperation::add);
     weights.reinit(owned, comm);
@@ -155,6 +164,8 @@ namespace ImmersedGrains
     // The condensed matrix acts on the unconstrained values (its
     // constrained columns are empty); its constrained rows hold only a
     // diagonal, and their entries of a right-hand side are zero.
+    Assert(mass_matrix.m() > 0,
+           dealii::ExcMessage("setup() without the mass matrix"));
     Vector owned_values(owned, triangulation.get_communicator());
     owned_values = f;
     mass_matrix.vmult(rhs, owned_values);

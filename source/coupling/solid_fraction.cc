@@ -77,7 +77,10 @@ namespace ImmersedGrains
   void
   SolidFraction<dim>::setup()
   {
-    filter.setup(parameters.lumped, parameters.smoothing_length);
+    // The felt fraction (project()) needs the mass matrix.
+    filter.setup(parameters.lumped,
+                 parameters.smoothing_length,
+                 parameters.smoothing_length > 0);
     fraction = filter.make_ghosted_vector();
     if (parameters.smoothing_length > 0)
       felt = filter.make_ghosted_vector();

@@ -272,8 +272,10 @@ namespace ImmersedGrains
 
     std::vector<dealii::types::global_dof_index> target_dofs;
     std::vector<Target>                          targets;
-    std::vector<std::vector<Expansion>>          expansion(dofs_per_cell);
-    std::vector<Diagonal>                        diagonals;
+    // Each local DoF's targets, one after the other (offsets[i] on).
+    std::vector<Expansion>    expansion;
+    std::vector<unsigned int> offsets;
+    std::vector<Diagonal>     diagonals;
     // The index of @p dof among the targets, added if new; -1 if its row
     // is not owned here or lies in another block than @p block.
     const auto target_of = [&](const dealii::types::global_dof_index dof,
@@ -296,6 +298,7 @@ namespace ImmersedGrains
 
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
     {
+      offsets.push_back(expansion.size());
       const unsigned int block     = dof_block[i];
       const unsigned int component = component_of[i];
       if (!constraints.is_constrained(dofs[i]))
@@ -303,7 +306,7 @@ namespace ImmersedGrains
         const int t = target_of(dofs[i], block, component);
         if (t < 0)
           return false;
-        expansion[i].push_back({static_cast<std::uint16_t>(t), 1.0});
+        expansion.push_back({static_cast<std::uint16_t>(t), 1.0});
         continue;
       }
       if (constraints.is_inhomogeneously_constrained(dofs[i]))
@@ -314,7 +317,7 @@ namespace ImmersedGrains
         const int t = target_of(master, block, component);
         if (t < 0)
           return false;
-        expansion[i].push_back({static_cast<std::uint16_t>(t), weight});
+        expansion.push_back({static_cast<std::uint16_t>(t), weight});
       }
       const int row = owned_row(dofs[i]);
       if (row < 0 || blocks.global_to_local(dofs[i]).first != block)
@@ -370,12 +373,14 @@ namespace ImmersedGrains
                              entries.begin(),
                              entries.end());
     condensed_expansion_start.push_back(condensed_expansion_offsets.size());
-    for (const auto &e : expansion)
-    {
-      condensed_expansion_offsets.push_back(condensed_expansion.size());
-      condensed_expansion.insert(condensed_expansion.end(), e.begin(), e.end());
-    }
-    condensed_expansion_offsets.push_back(condensed_expansion.size());
+    for (const unsigned int offset : offsets)
+      condensed_expansion_offsets.push_back(condensed_expansion.size() +
+                                            offset);
+    condensed_expansion_offsets.push_back(condensed_expansion.size() +
+                                          expansion.size());
+    condensed_expansion.insert(condensed_expansion.end(),
+                               expansion.begin(),
+                               expansion.end());
     condensed_diagonals_start.push_back(condensed_diagonals.size());
     condensed_diagonals.insert(condensed_diagonals.end(),
                                diagonals.begin(),

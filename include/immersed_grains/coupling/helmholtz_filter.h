@@ -42,9 +42,12 @@ namespace ImmersedGrains
     HelmholtzFilter(const dealii::parallel::distributed::Triangulation<dim> &,
                     const Geometry<dim> &geometry);
 
-    /** (Re)builds DoFs and the matrix; call after every mesh change. */
+    /**
+     * (Re)builds DoFs and the matrix; call after every mesh change. The
+     * consistent mass matrix for mass_product() only @p with_mass_matrix.
+     */
     void
-    setup(bool lumped, double length);
+    setup(bool lumped, double length, bool with_mass_matrix = false);
 
     /** A vector over the locally owned DoFs, zero (for right-hand sides). */
     Vector
