@@ -294,15 +294,14 @@ namespace ImmersedGrains
       // cell-mean velocity. Every grain of the cell has the same shape, so
       // their drags add up to one: sum beta_i against the cell-mean
       // velocity minus sum beta_i v_i.
-      const auto &fe_values = *context.fe_values;
-      double      volume    = 0;
+      const auto &JxW    = *context.JxW;
+      double      volume = 0;
       std::fill(shape.begin(), shape.end(), 0.0);
-      for (const unsigned int q : fe_values.quadrature_point_indices())
+      for (unsigned int q = 0; q < JxW.size(); ++q)
       {
-        volume += fe_values.JxW(q);
+        volume += JxW[q];
         for (unsigned int a = 0; a < n_s; ++a)
-          shape[a] +=
-            fe_values.shape_value(dofs.velocity[a][0], q) * fe_values.JxW(q);
+          shape[a] += (*context.shapes)[q].N[a] * JxW[q];
       }
       for (unsigned int a = 0; a < n_s; ++a)
         shape[a] /= volume;

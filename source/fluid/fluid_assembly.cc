@@ -2,8 +2,8 @@
 #include <cmath>
 #include <limits>
 
+#include <deal.II/base/geometry_info.h>
 #include <deal.II/base/quadrature_lib.h>
-#include <deal.II/fe/fe_values.h>
 
 #include <immersed_grains/fluid/assembly_terms.h>
 #include <immersed_grains/fluid/cell_gather.h>
@@ -23,22 +23,21 @@ namespace ImmersedGrains
     // cell's total drag coefficient and grain momentum.
     template <int dim>
     void
-    average_drag_over_cell(const dealii::FEValues<dim> &fe_values,
-                           MixtureValues<dim>          &mixture)
+    average_drag_over_cell(const std::vector<double> &JxW,
+                           MixtureValues<dim>        &mixture)
     {
       double                 beta = 0, volume = 0;
       dealii::Tensor<1, dim> momentum;
-      for (const unsigned int q : fe_values.quadrature_point_indices())
+      for (unsigned int q = 0; q < JxW.size(); ++q)
       {
-        const double JxW = fe_values.JxW(q);
-        beta += mixture.drag_coefficient[q] * JxW;
+        beta += mixture.drag_coefficient[q] * JxW[q];
         momentum +=
-          mixture.drag_coefficient[q] * mixture.grain_velocity[q] * JxW;
-        volume += JxW;
+          mixture.drag_coefficient[q] * mixture.grain_velocity[q] * JxW[q];
+        volume += JxW[q];
       }
       beta /= volume;
       momentum /= volume;
-      for (const unsigned int q : fe_values.quadrature_point_indices())
+      for (unsigned int q = 0; q < JxW.size(); ++q)
       {
         mixture.drag_coefficient[q] = beta;
         mixture.grain_velocity[q] =
@@ -204,16 +203,8 @@ namespace ImmersedGrains
     }
 
     const dealii::QGauss<dim> quadrature(fe.degree + 1);
-    dealii::FEValues<dim>     fe_values(mapping,
-                                    fe,
-                                    quadrature,
-                                    dealii::update_values |
-                                      dealii::update_gradients |
-                                      dealii::update_quadrature_points |
-                                      dealii::update_JxW_values);
-
-    const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
-    const unsigned int n_q           = quadrature.size();
+    const unsigned int        dofs_per_cell = fe.n_dofs_per_cell();
+    const unsigned int        n_q           = quadrature.size();
 
     // Local index of velocity component c of scalar Q2 function a, and of
     // pressure function b.
@@ -243,13 +234,41 @@ namespace ImmersedGrains
     std::vector<double>                          local_solution(dofs_per_cell);
     std::vector<double> local_old(dofs_per_cell), local_older(dofs_per_cell);
 
-    ScalarShapes<dim> shapes;
-    shapes.resize(n_s, n_p);
-    CellIntegrals integrals;
+    // Every cell is an axis-parallel box (the mapping is MappingCartesian),
+    // so the shape functions' values at the quadrature points are the
+    // reference cell's and their gradients the reference gradients over
+    // the cell's extents: computed once here and scaled per cell, instead
+    // of FEValues::reinit copying all of them for every cell (3 % of the
+    // 3D cloud's run).
+    std::vector<ScalarShapes<dim>> reference_shapes(n_q);
+    for (unsigned int q = 0; q < n_q; ++q)
+    {
+      const auto &x = quadrature.point(q);
+      reference_shapes[q].resize(n_s, n_p);
+      for (unsigned int a = 0; a < n_s; ++a)
+      {
+        reference_shapes[q].N[a] = fe.shape_value(velocity_dof[a][0], x);
+        const auto grad          = fe.shape_grad(velocity_dof[a][0], x);
+        for (unsigned int d = 0; d < dim; ++d)
+          reference_shapes[q].G[d][a] = grad[d];
+      }
+      for (unsigned int b = 0; b < n_p; ++b)
+      {
+        reference_shapes[q].Np[b] = fe.shape_value(pressure_dof[b], x);
+        const auto grad           = fe.shape_grad(pressure_dof[b], x);
+        for (unsigned int d = 0; d < dim; ++d)
+          reference_shapes[q].Gp[d][b] = grad[d];
+      }
+    }
+    std::vector<ScalarShapes<dim>>  cell_shapes = reference_shapes;
+    std::vector<double>             JxW_values(n_q);
+    std::vector<dealii::Point<dim>> points(n_q);
+    CellIntegrals                   integrals;
     integrals.resize(dim, n_s, n_p, convection_derivative);
     std::vector<double> advection_weight(n_s);
     CellContext<dim>    context;
-    context.fe_values             = &fe_values;
+    context.shapes                = &cell_shapes;
+    context.JxW                   = &JxW_values;
     context.local_solution        = &local_solution;
     context.preconditioner_pieces = assemble_preconditioner_matrices;
 
@@ -275,7 +294,28 @@ namespace ImmersedGrains
       if (!cell->is_locally_owned())
         continue;
       const unsigned int cell_number = owned_cell++;
-      fe_values.reinit(cell);
+      {
+        const dealii::Point<dim>     lower = cell->vertex(0);
+        const dealii::Tensor<1, dim> extent =
+          cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1) -
+          lower;
+        double measure = 1;
+        for (unsigned int d = 0; d < dim; ++d)
+          measure *= extent[d];
+        for (unsigned int q = 0; q < n_q; ++q)
+        {
+          JxW_values[q] = quadrature.weight(q) * measure;
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            points[q][d] = lower[d] + extent[d] * quadrature.point(q)[d];
+            const double inverse = 1.0 / extent[d];
+            for (unsigned int a = 0; a < n_s; ++a)
+              cell_shapes[q].G[d][a] = reference_shapes[q].G[d][a] * inverse;
+            for (unsigned int b = 0; b < n_p; ++b)
+              cell_shapes[q].Gp[d][b] = reference_shapes[q].Gp[d][b] * inverse;
+          }
+        }
+      }
       cell_gather->gather(cell_number, solution, local_solution);
       if (with_history)
       {
@@ -291,11 +331,8 @@ namespace ImmersedGrains
       // 38-42).
       double cell_drag = 0, cell_viscosity = 0;
 
-      mixture_fields->evaluate(cell,
-                               fe_values.get_quadrature_points(),
-                               quadrature.get_points(),
-                               time,
-                               mixture);
+      mixture_fields->evaluate(
+        cell, points, quadrature.get_points(), time, mixture);
       const double h            = std::pow(cell->measure(), 1.0 / dim);
       const double floor_factor = schur_floor_factor(h, box_size);
       using DragAveraging       = typename FluidParameters<dim>::DragAveraging;
@@ -303,12 +340,12 @@ namespace ImmersedGrains
           (parameters.drag_averaging == DragAveraging::jump &&
            drag_jumps_in_cell(mixture, h, mu, parameters.drag_jump_contrast)))
       {
-        average_drag_over_cell(fe_values, mixture);
+        average_drag_over_cell(JxW_values, mixture);
         ++averaged_cells;
       }
       if (terms.forcing)
       {
-        forcing->vector_value_list(fe_values.get_quadrature_points(), f);
+        forcing->vector_value_list(points, f);
         for (unsigned int q = 0; q < n_q; ++q)
           max_forcing = std::max(max_forcing, f[q].l2_norm());
       }
@@ -321,24 +358,9 @@ namespace ImmersedGrains
 
       for (unsigned int q = 0; q < n_q; ++q)
       {
-        for (unsigned int a = 0; a < n_s; ++a)
-        {
-          const unsigned int k = velocity_dof[a][0];
-          shapes.N[a]          = fe_values.shape_value(k, q);
-          const auto grad      = fe_values.shape_grad(k, q);
-          for (unsigned int d = 0; d < dim; ++d)
-            shapes.G[d][a] = grad[d];
-        }
-        for (unsigned int b = 0; b < n_p; ++b)
-        {
-          const unsigned int k = pressure_dof[b];
-          shapes.Np[b]         = fe_values.shape_value(k, q);
-          const auto grad      = fe_values.shape_grad(k, q);
-          for (unsigned int d = 0; d < dim; ++d)
-            shapes.Gp[d][b] = grad[d];
-        }
-        const auto &N = shapes.N;
-        const auto &G = shapes.G;
+        const ScalarShapes<dim> &shapes = cell_shapes[q];
+        const auto              &N      = shapes.N;
+        const auto              &G      = shapes.G;
 
         // The current iterate and the history at this point.
         state.u         = dealii::Tensor<1, dim>();
@@ -375,7 +397,7 @@ namespace ImmersedGrains
         if (terms.forcing)
           for (unsigned int d = 0; d < dim; ++d)
             state.forcing[d] = f[q](d);
-        const double JxW = fe_values.JxW(q);
+        const double JxW = JxW_values[q];
 
         MomentumCoefficients<dim> m;
         for (const auto *term : terms.at_points)

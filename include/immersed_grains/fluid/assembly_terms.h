@@ -130,7 +130,9 @@ namespace ImmersedGrains
   struct CellContext
   {
     typename dealii::Triangulation<dim>::active_cell_iterator cell;
-    const dealii::FEValues<dim> *fe_values = nullptr;
+    // The shape functions and the weights at the cell's quadrature points.
+    const std::vector<ScalarShapes<dim>> *shapes = nullptr;
+    const std::vector<double>            *JxW    = nullptr;
     // The current iterate's coefficients on the cell (local numbering).
     const std::vector<double> *local_solution        = nullptr;
     bool                       preconditioner_pieces = false;
