@@ -456,11 +456,26 @@ namespace ImmersedGrains
     // C^T K C and C^T f in the cell, over its target rows.
     condensed_matrix.assign(n_targets * n_targets, 0.0);
     condensed_rhs.assign(n_targets, 0.0);
+    // Most of a cell's DoFs are free: their row or column is one target
+    // with weight 1, and their entries go straight to it (the same sum:
+    // 1 * 1 * value is value).
+    single_target.resize(dofs_per_cell);
+    for (unsigned int i = 0; i < dofs_per_cell; ++i)
+      single_target[i] = offsets[i + 1] == offsets[i] + 1 &&
+                             condensed_expansion[offsets[i]].weight == 1.0 ?
+                           condensed_expansion[offsets[i]].target :
+                           -1;
     for (const Pair &pair : pairs)
     {
       const double value = cell_matrix(pair.i, pair.j);
       if (value == 0)
         continue;
+      if (single_target[pair.i] >= 0 && single_target[pair.j] >= 0)
+      {
+        condensed_matrix[single_target[pair.i] * n_targets +
+                         single_target[pair.j]] += value;
+        continue;
+      }
       for (unsigned int e = offsets[pair.i]; e < offsets[pair.i + 1]; ++e)
       {
         const Expansion &row    = condensed_expansion[e];

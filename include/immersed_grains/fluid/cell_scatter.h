@@ -135,6 +135,7 @@ namespace ImmersedGrains
     std::vector<std::uint16_t> condensed_row_lengths; // entries per target row
     std::vector<Entry>         condensed_entries;
     mutable std::vector<double> condensed_matrix, condensed_rhs;
+    mutable std::vector<int>    single_target;
 
     // Records a cell for the condensed path; false if it does not qualify.
     bool
