@@ -443,6 +443,7 @@ namespace ImmersedGrains
     // it, except before the first step or after a mesh change.
     if (drag_as_field() && !filtered_velocity_current)
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
+                                     fluid.get_cell_gather(),
                                      fluid.get_solution());
     filtered_velocity_current = true;
     const bool implicit_velocity =
@@ -610,6 +611,7 @@ namespace ImmersedGrains
     // A later sub-step sees the same fluid: its filtered fields stand.
     if (drag_as_field() && as_predicted)
       filtered_drag->filter_velocity(fluid.get_dof_handler(),
+                                     fluid.get_cell_gather(),
                                      fluid.get_solution(),
                                      implicit_velocity,
                                      solid_scale());
@@ -733,6 +735,7 @@ namespace ImmersedGrains
       return {on_fluid, on_grains};
     if (filtered_drag)
       on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
+                                               fluid.get_cell_gather(),
                                                fluid.get_solution(),
                                                solid_scale());
     if (!drag_as_field())

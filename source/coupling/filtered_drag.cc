@@ -1,28 +1,13 @@
+#include <deal.II/base/geometry_info.h>
 #include <deal.II/base/quadrature_lib.h>
-#include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/fe_system.h>
 
 #include <immersed_grains/coupling/filtered_drag.h>
+#include <immersed_grains/fluid/assembly_terms.h>
+#include <immersed_grains/fluid/cell_gather.h>
 
 namespace ImmersedGrains
 {
-  namespace
-  {
-    // The solid scale at the quadrature points of @p fe_values' cell; empty
-    // where it is 1 everywhere.
-    template <int dim>
-    std::vector<double>
-    scale_at(const typename FilteredDrag<dim>::SolidScale &solid_scale,
-             const dealii::FEValues<dim>                  &fe_values)
-    {
-      if (!solid_scale)
-        return {};
-      const typename dealii::Triangulation<dim>::active_cell_iterator cell(
-        fe_values.get_cell());
-      return solid_scale(cell, fe_values.get_quadrature().get_points());
-    }
-  } // namespace
-
-
   template <int dim>
   FilteredDrag<dim>::FilteredDrag(
     const dealii::parallel::distributed::Triangulation<dim> &tria,
@@ -157,78 +142,75 @@ namespace ImmersedGrains
   template <typename F>
   void
   FilteredDrag<dim>::for_each_cell(
-    const dealii::DoFHandler<dim> &fluid_dof_handler,
-    const F                       &f) const
+    const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+    const CellGather<dim>                            &gather,
+    const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+    const F                                          &f) const
   {
-    const auto               &fluid_fe = fluid_dof_handler.get_fe();
+    const auto &fluid_fe =
+      dynamic_cast<const dealii::FESystem<dim> &>(fluid_dof_handler.get_fe());
+    const ScalarDofs<dim>     dofs(fluid_fe);
     const dealii::QGauss<dim> quadrature(fluid_fe.degree + 1);
-    dealii::FEValues<dim>     fluid_values(filter.get_mapping(),
-                                       fluid_fe,
-                                       quadrature,
-                                       dealii::update_values |
-                                         dealii::update_gradients |
-                                         dealii::update_JxW_values);
-    dealii::FEValues<dim>     filter_values(filter.get_mapping(),
-                                        filter.get_fe(),
-                                        quadrature,
-                                        dealii::update_values);
-    for (const auto &cell : fluid_dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-      {
-        fluid_values.reinit(cell);
-        const auto filter_cell = filter.dof_cell(cell);
-        filter_values.reinit(filter_cell);
-        f(fluid_values, filter_values, filter_cell);
-      }
-  }
+    const unsigned int        n_q = quadrature.size();
+    const unsigned int        n_s = dofs.velocity.size();
+    const unsigned int        n_p = dofs.pressure.size();
+    const unsigned int        n   = filter.get_fe().n_dofs_per_cell();
 
-
-  template <int dim>
-  template <typename Quantity>
-  void
-  FilteredDrag<dim>::filter_quantity(
-    const dealii::DoFHandler<dim>                          &fluid_dof_handler,
-    const Quantity                                         &quantity,
-    std::array<typename HelmholtzFilter<dim>::Vector, dim> &result)
-  {
-    std::array<typename HelmholtzFilter<dim>::Vector, dim> rhs;
-    for (auto &r : rhs)
-      r = filter.make_owned_vector();
-
-    const unsigned int                  n = filter.get_fe().n_dofs_per_cell();
-    std::vector<dealii::Tensor<1, dim>> values;
-    std::array<dealii::Vector<double>, dim>      local;
-    std::vector<dealii::types::global_dof_index> indices(n);
-    for (auto &l : local)
-      l.reinit(n);
-
-    for_each_cell(fluid_dof_handler,
-                  [&](const dealii::FEValues<dim> &fluid_values,
-                      const dealii::FEValues<dim> &filter_values,
-                      const auto                  &filter_cell)
-                  {
-                    values.resize(fluid_values.n_quadrature_points);
-                    quantity(fluid_values, values);
-                    for (auto &l : local)
-                      l = 0;
-                    for (unsigned int q = 0; q < values.size(); ++q)
-                      for (unsigned int j = 0; j < n; ++j)
-                      {
-                        const double weight =
-                          filter_values.shape_value(j, q) * fluid_values.JxW(q);
-                        for (unsigned int d = 0; d < dim; ++d)
-                          local[d](j) += values[q][d] * weight;
-                      }
-                    for (unsigned int d = 0; d < dim; ++d)
-                      filter.add_cell_contribution(filter_cell,
-                                                   local[d],
-                                                   indices,
-                                                   rhs[d]);
-                  });
-    for (unsigned int d = 0; d < dim; ++d)
+    // Reference values, point by point: N[q n_s + a], Gp[(q dim + d) n_p + b].
+    std::vector<double> N(n_q * n_s), Gp(n_q * dim * n_p);
+    CellQuadrature      data;
+    data.filter_values.resize(n_q * n);
+    data.reference_points = quadrature.get_points();
+    for (unsigned int q = 0; q < n_q; ++q)
     {
-      rhs[d].compress(dealii::VectorOperation::add);
-      filter.solve(rhs[d], result[d]);
+      const auto &x = quadrature.point(q);
+      for (unsigned int a = 0; a < n_s; ++a)
+        N[q * n_s + a] = fluid_fe.shape_value(dofs.velocity[a][0], x);
+      for (unsigned int b = 0; b < n_p; ++b)
+      {
+        const auto grad = fluid_fe.shape_grad(dofs.pressure[b], x);
+        for (unsigned int d = 0; d < dim; ++d)
+          Gp[(q * dim + d) * n_p + b] = grad[d];
+      }
+      for (unsigned int j = 0; j < n; ++j)
+        data.filter_values[q * n + j] = filter.get_fe().shape_value(j, x);
+    }
+    data.velocity.resize(n_q);
+    data.pressure_gradient.resize(n_q);
+    data.JxW.resize(n_q);
+
+    std::vector<double> local(fluid_fe.n_dofs_per_cell());
+    for (const auto &cell : fluid_dof_handler.active_cell_iterators())
+    {
+      if (!cell->is_locally_owned())
+        continue;
+      const bool owned = gather.gather(cell, fluid_solution, local);
+      Assert(owned, dealii::ExcInternalError());
+      (void)owned;
+      const dealii::Tensor<1, dim> extent =
+        cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1) -
+        cell->vertex(0);
+      double measure = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        measure *= extent[d];
+      for (unsigned int q = 0; q < n_q; ++q)
+      {
+        data.JxW[q] = quadrature.weight(q) * measure;
+        dealii::Tensor<1, dim> u, grad_p;
+        for (unsigned int a = 0; a < n_s; ++a)
+          for (unsigned int c = 0; c < dim; ++c)
+            u[c] += local[dofs.velocity[a][c]] * N[q * n_s + a];
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          for (unsigned int b = 0; b < n_p; ++b)
+            grad_p[d] += local[dofs.pressure[b]] * Gp[(q * dim + d) * n_p + b];
+          grad_p[d] /= extent[d];
+        }
+        data.velocity[q]          = u;
+        data.pressure_gradient[q] = grad_p;
+      }
+      data.filter_cell = filter.dof_cell(cell);
+      f(typename dealii::Triangulation<dim>::active_cell_iterator(cell), data);
     }
   }
 
@@ -237,30 +219,83 @@ namespace ImmersedGrains
   void
   FilteredDrag<dim>::filter_velocity(
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+    const CellGather<dim>                            &gather,
     const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
     const bool                                        with_pressure_gradient,
     const SolidScale                                 &solid_scale)
   {
-    const dealii::FEValuesExtractors::Vector velocities(0);
-    const dealii::FEValuesExtractors::Scalar pressure(dim);
-    filter_quantity(
-      fluid_dof_handler,
-      [&](const dealii::FEValues<dim>         &fe_values,
-          std::vector<dealii::Tensor<1, dim>> &values)
-      { fe_values[velocities].get_function_values(fluid_solution, values); },
-      velocity);
+    // (N_j, u) and (N_j, s grad p) in one pass over the cells.
+    std::array<typename HelmholtzFilter<dim>::Vector, dim> velocity_rhs,
+      pressure_rhs;
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      velocity_rhs[d] = filter.make_owned_vector();
+      if (with_pressure_gradient)
+        pressure_rhs[d] = filter.make_owned_vector();
+    }
+
+    const unsigned int n = filter.get_fe().n_dofs_per_cell();
+    std::array<dealii::Vector<double>, dim>      local_velocity, local_pressure;
+    std::vector<dealii::types::global_dof_index> indices(n);
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      local_velocity[d].reinit(n);
+      local_pressure[d].reinit(n);
+    }
+    for_each_cell(fluid_dof_handler,
+                  gather,
+                  fluid_solution,
+                  [&](const auto &cell, const CellQuadrature &data)
+                  {
+                    const std::vector<double> scale =
+                      with_pressure_gradient && solid_scale ?
+                        solid_scale(cell, data.reference_points) :
+                        std::vector<double>();
+                    for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      local_velocity[d] = 0;
+                      local_pressure[d] = 0;
+                    }
+                    for (unsigned int q = 0; q < data.JxW.size(); ++q)
+                    {
+                      const dealii::Tensor<1, dim> grad_p =
+                        scale.empty() ? data.pressure_gradient[q] :
+                                        scale[q] * data.pressure_gradient[q];
+                      for (unsigned int j = 0; j < n; ++j)
+                      {
+                        const double weight =
+                          data.filter_values[q * n + j] * data.JxW[q];
+                        for (unsigned int d = 0; d < dim; ++d)
+                        {
+                          local_velocity[d](j) += data.velocity[q][d] * weight;
+                          local_pressure[d](j) += grad_p[d] * weight;
+                        }
+                      }
+                    }
+                    for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      filter.add_cell_contribution(data.filter_cell,
+                                                   local_velocity[d],
+                                                   indices,
+                                                   velocity_rhs[d]);
+                      if (with_pressure_gradient)
+                        filter.add_cell_contribution(data.filter_cell,
+                                                     local_pressure[d],
+                                                     indices,
+                                                     pressure_rhs[d]);
+                    }
+                  });
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      velocity_rhs[d].compress(dealii::VectorOperation::add);
+      filter.solve(velocity_rhs[d], velocity[d]);
+    }
     if (with_pressure_gradient)
-      filter_quantity(
-        fluid_dof_handler,
-        [&](const dealii::FEValues<dim>         &fe_values,
-            std::vector<dealii::Tensor<1, dim>> &values)
-        {
-          fe_values[pressure].get_function_gradients(fluid_solution, values);
-          const auto scale = scale_at(solid_scale, fe_values);
-          for (unsigned int q = 0; q < scale.size(); ++q)
-            values[q] *= scale[q];
-        },
-        pressure_gradient);
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        pressure_rhs[d].compress(dealii::VectorOperation::add);
+        filter.solve(pressure_rhs[d], pressure_gradient[d]);
+      }
   }
 
 
@@ -376,45 +411,60 @@ namespace ImmersedGrains
   dealii::Tensor<1, dim>
   FilteredDrag<dim>::force_on_fluid(
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+    const CellGather<dim>                            &gather,
     const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
     const SolidScale                                 &solid_scale) const
   {
-    const dealii::FEValuesExtractors::Vector velocities(0);
-    const dealii::FEValuesExtractors::Scalar pressure(dim);
-    std::vector<dealii::Tensor<1, dim>>      u, grad_p;
-    std::vector<double>                      b, a;
-    std::array<std::vector<double>, dim>     m;
-    dealii::Tensor<1, dim>                   force;
-    for_each_cell(
-      fluid_dof_handler,
-      [&](const dealii::FEValues<dim> &fluid_values,
-          const dealii::FEValues<dim> &filter_values,
-          const auto &)
-      {
-        const unsigned int n_q = fluid_values.n_quadrature_points;
-        grad_p.resize(n_q);
-        a.resize(n_q);
-        fluid_values[pressure].get_function_gradients(fluid_solution, grad_p);
-        filter_values.get_function_values(alpha, a);
-        const auto scale = scale_at(solid_scale, fluid_values);
-        for (unsigned int q = 0; q < n_q; ++q)
-          force -= (scale.empty() ? 1.0 : scale[q]) * a[q] * grad_p[q] *
-                   fluid_values.JxW(q);
-        if (!drag_as_field)
-          return;
-        u.resize(n_q);
-        b.resize(n_q);
-        fluid_values[velocities].get_function_values(fluid_solution, u);
-        filter_values.get_function_values(beta, b);
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          m[d].resize(n_q);
-          filter_values.get_function_values(momentum[d], m[d]);
-        }
-        for (unsigned int q = 0; q < n_q; ++q)
-          for (unsigned int d = 0; d < dim; ++d)
-            force[d] -= (b[q] * u[q][d] - m[d][q]) * fluid_values.JxW(q);
-      });
+    const unsigned int n = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::types::global_dof_index> indices(n);
+    // The filtered fields' coefficients on the cell: alpha, beta, m.
+    std::vector<double>                  local_alpha(n), local_beta(n);
+    std::array<std::vector<double>, dim> local_momentum;
+    for (auto &m : local_momentum)
+      m.resize(n);
+    dealii::Tensor<1, dim> force;
+    for_each_cell(fluid_dof_handler,
+                  gather,
+                  fluid_solution,
+                  [&](const auto &cell, const CellQuadrature &data)
+                  {
+                    data.filter_cell->get_dof_indices(indices);
+                    for (unsigned int j = 0; j < n; ++j)
+                    {
+                      local_alpha[j] = alpha[indices[j]];
+                      if (drag_as_field)
+                      {
+                        local_beta[j] = beta[indices[j]];
+                        for (unsigned int d = 0; d < dim; ++d)
+                          local_momentum[d][j] = momentum[d][indices[j]];
+                      }
+                    }
+                    const std::vector<double> scale =
+                      solid_scale ? solid_scale(cell, data.reference_points) :
+                                    std::vector<double>();
+                    for (unsigned int q = 0; q < data.JxW.size(); ++q)
+                    {
+                      const double          *psi = &data.filter_values[q * n];
+                      double                 a = 0, b = 0;
+                      dealii::Tensor<1, dim> m;
+                      for (unsigned int j = 0; j < n; ++j)
+                      {
+                        a += local_alpha[j] * psi[j];
+                        if (drag_as_field)
+                        {
+                          b += local_beta[j] * psi[j];
+                          for (unsigned int d = 0; d < dim; ++d)
+                            m[d] += local_momentum[d][j] * psi[j];
+                        }
+                      }
+                      force -= (scale.empty() ? 1.0 : scale[q]) * a *
+                               data.pressure_gradient[q] * data.JxW[q];
+                      if (drag_as_field)
+                        for (unsigned int d = 0; d < dim; ++d)
+                          force[d] -=
+                            (b * data.velocity[q][d] - m[d]) * data.JxW[q];
+                    }
+                  });
     return dealii::Utilities::MPI::sum(
       force, fluid_dof_handler.get_triangulation().get_communicator());
   }

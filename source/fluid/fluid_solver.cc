@@ -1099,6 +1099,14 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  const CellGather<dim> &
+  FluidSolver<dim>::get_cell_gather() const
+  {
+    return *cell_gather;
+  }
+
+
+  template <int dim>
   double
   FluidSolver<dim>::get_time() const
   {

@@ -14,6 +14,9 @@
 
 namespace ImmersedGrains
 {
+  template <int dim>
+  class CellGather;
+
   /**
    * The grains' implicit drag as a continuous field (Coupling/Drag
    * distribution = filtered). The point drags beta_i (u - v~_i) are spread
@@ -66,10 +69,12 @@ namespace ImmersedGrains
 
     /** Filters the velocity (and, if @p with_pressure_gradient, the
      * pressure gradient times @p solid_scale, the force per volume on the
-     * grains) of a Q2^dim-Q1 fluid solution. */
+     * grains) of a Q2^dim-Q1 fluid solution, read cell by cell through
+     * @p gather (FluidSolver::get_cell_gather()). */
     void
     filter_velocity(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+      const CellGather<dim>                            &gather,
       const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
       bool              with_pressure_gradient = false,
       const SolidScale &solid_scale            = SolidScale());
@@ -101,6 +106,7 @@ namespace ImmersedGrains
     dealii::Tensor<1, dim>
     force_on_fluid(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+      const CellGather<dim>                            &gather,
       const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
       const SolidScale &solid_scale = SolidScale()) const;
 
@@ -115,20 +121,32 @@ namespace ImmersedGrains
       const std::array<const typename HelmholtzFilter<dim>::Vector *, n_fields>
         &fields) const;
 
-    // Calls @p f(fluid_values, filter_values, filter_cell) on each locally
-    // owned cell, both FEValues at the fluid's Gauss points (which
-    // integrate Q1 x Q2 x Q2 exactly).
+    // The fluid's velocity and pressure gradient, and the filter's shape
+    // functions, at the fluid's Gauss points of one cell (which integrate
+    // Q1 x Q2 x Q2 exactly).
+    struct CellQuadrature
+    {
+      std::vector<dealii::Tensor<1, dim>> velocity, pressure_gradient;
+      std::vector<double>                 JxW;
+      // filter_values[q * n + j]: the filter's function j at point q.
+      std::vector<double>                                    filter_values;
+      std::vector<dealii::Point<dim>>                        reference_points;
+      typename dealii::DoFHandler<dim>::active_cell_iterator filter_cell;
+    };
+
+    // Calls @p f(cell, quadrature) on each locally owned cell. Every cell
+    // is an axis-parallel box (MappingCartesian), so the shape functions'
+    // values are the reference cell's and their gradients the reference
+    // gradients over the cell's extents: computed once per call, with the
+    // fluid's coefficients read through @p gather, instead of two
+    // FEValues::reinit and a look-up in Epetra's map per DoF and cell.
     template <typename F>
     void
-    for_each_cell(const dealii::DoFHandler<dim> &fluid_dof_handler,
-                  const F                       &f) const;
-
-    // Filters the Q1 fields of a velocity-like quantity of the fluid.
-    template <typename Quantity>
-    void
-    filter_quantity(const dealii::DoFHandler<dim> &fluid_dof_handler,
-                    const Quantity                &quantity,
-                    std::array<typename HelmholtzFilter<dim>::Vector, dim> &);
+    for_each_cell(
+      const dealii::DoFHandler<dim>                    &fluid_dof_handler,
+      const CellGather<dim>                            &gather,
+      const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+      const F                                          &f) const;
 
     std::vector<dealii::Tensor<1, dim>>
     vector_values(

@@ -207,6 +207,11 @@ namespace ImmersedGrains
     const VectorType &
     get_solution() const;
 
+    /** Reads a locally owned cell's values from the solution (and every
+     * ghosted vector of its layout) without look-ups in Epetra's map. */
+    const CellGather<dim> &
+    get_cell_gather() const;
+
     double
     get_time() const;
 
