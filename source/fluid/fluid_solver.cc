@@ -52,9 +52,10 @@ namespace ImmersedGrains
     // whole system gives, which the velocity block's ILU and AMG need (3D
     // cloud, first steps: 14, 12, 8, 7, 6 outer iterations against 17, 15,
     // 10, 8, 8 unordered and 16, 15, 9, 8, 7 with the cells ordered by their
-    // face graph), from a graph (dim + 1)^2 times smaller: the graph of the
-    // whole system held all components' couplings, 400 entries per row in
-    // 3D, and its reordering was a fifth of the 3D cloud's first steps.
+    // face graph), from a graph about ten times smaller: the graph of the
+    // whole system held all components' couplings, about 400 entries per
+    // row in 3D, and its reordering was a fifth of the 3D cloud's first
+    // steps.
     template <int dim>
     void
     renumber_by_node_cuthill_mckee(dealii::DoFHandler<dim> &dof_handler)
