@@ -9,6 +9,25 @@ namespace ImmersedGrains
 {
   namespace
   {
+    // std::lower_bound without branches on the comparisons: the columns
+    // sought in a row are scattered, so every branch of the bisection is a
+    // coin toss for the predictor, and the positions' search for every
+    // pair of every cell was a twentieth of the 3D cloud's first steps.
+    const int *
+    sorted_lower_bound(const int *first, const int *last, const int value)
+    {
+      std::size_t n = last - first;
+      if (n == 0)
+        return first;
+      while (n > 1)
+      {
+        const std::size_t half = n / 2;
+        first                  = first[half] < value ? first + half : first;
+        n -= half;
+      }
+      return first + (*first < value ? 1 : 0);
+    }
+
     // What AffineConstraints puts on a constrained row's diagonal where the
     // cell matrix's own entry is zero: the mean absolute diagonal, else
     // the l1 norm over the rows, else 1.
@@ -203,7 +222,7 @@ namespace ImmersedGrains
         const int *begin  = row_indices[pair.row_block][pair.column_block][row];
         const int *end =
           begin + row_lengths[pair.row_block][pair.column_block][row];
-        const int *found = std::lower_bound(begin, end, column);
+        const int *found = sorted_lower_bound(begin, end, column);
         direct           = column >= 0 && found != end && *found == column &&
                  found - begin < skip;
         if (direct)
@@ -254,7 +273,7 @@ namespace ImmersedGrains
         static_cast<dealii::TrilinosWrappers::types::int_type>(index));
       const int *begin = row_indices[b][c][row];
       const int *end   = begin + row_lengths[b][c][row];
-      const int *found = std::lower_bound(begin, end, column);
+      const int *found = sorted_lower_bound(begin, end, column);
       return column >= 0 && found != end && *found == column &&
                  found - begin < skip ?
                static_cast<std::uint16_t>(found - begin) :
@@ -352,7 +371,7 @@ namespace ImmersedGrains
             row_indices[row_block][targets[b].block][targets[a].row];
           const int *end =
             begin + row_lengths[row_block][targets[b].block][targets[a].row];
-          const int *found = std::lower_bound(begin, end, column);
+          const int *found = sorted_lower_bound(begin, end, column);
           if (column < 0 || found == end || *found != column ||
               found - begin >= skip)
             return false;
