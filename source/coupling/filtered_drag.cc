@@ -266,10 +266,10 @@ namespace ImmersedGrains
                         const double weight =
                           data.filter_values[q * n + j] * data.JxW[q];
                         for (unsigned int d = 0; d < dim; ++d)
-                        {
                           local_velocity[d](j) += data.velocity[q][d] * weight;
-                          local_pressure[d](j) += grad_p[d] * weight;
-                        }
+                        if (with_pressure_gradient)
+                          for (unsigned int d = 0; d < dim; ++d)
+                            local_pressure[d](j) += grad_p[d] * weight;
                       }
                     }
                     for (unsigned int d = 0; d < dim; ++d)
