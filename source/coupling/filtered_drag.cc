@@ -1,4 +1,3 @@
-#include <deal.II/base/geometry_info.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_system.h>
 
@@ -152,34 +151,22 @@ namespace ImmersedGrains
     const ScalarDofs<dim>     dofs(fluid_fe);
     const dealii::QGauss<dim> quadrature(fluid_fe.degree + 1);
     const unsigned int        n_q = quadrature.size();
-    const unsigned int        n_s = dofs.velocity.size();
-    const unsigned int        n_p = dofs.pressure.size();
-    const unsigned int        n   = filter.get_fe().n_dofs_per_cell();
-
-    // Reference values, point by point: N[q n_s + a], Gp[(q dim + d) n_p + b].
-    std::vector<double> N(n_q * n_s), Gp(n_q * dim * n_p);
-    CellQuadrature      data;
-    data.filter_values.resize(n_q * n);
+    // Reference values kept across cells (CellPointShapes): a cell costs
+    // its Jacobians.
+    CellPointShapes<dim> velocity_shapes(fluid_fe.base_element(0)),
+      pressure_shapes(fluid_fe.base_element(1)), filter_shapes(filter.get_fe());
+    CellQuadrature data;
     data.reference_points = quadrature.get_points();
-    for (unsigned int q = 0; q < n_q; ++q)
-    {
-      const auto &x = quadrature.point(q);
-      for (unsigned int a = 0; a < n_s; ++a)
-        N[q * n_s + a] = fluid_fe.shape_value(dofs.velocity[a][0], x);
-      for (unsigned int b = 0; b < n_p; ++b)
-      {
-        const auto grad = fluid_fe.shape_grad(dofs.pressure[b], x);
-        for (unsigned int d = 0; d < dim; ++d)
-          Gp[(q * dim + d) * n_p + b] = grad[d];
-      }
-      for (unsigned int j = 0; j < n; ++j)
-        data.filter_values[q * n + j] = filter.get_fe().shape_value(j, x);
-    }
+    data.filter_shapes    = &filter_shapes;
     data.velocity.resize(n_q);
     data.pressure_gradient.resize(n_q);
     data.JxW.resize(n_q);
 
-    std::vector<double> local(fluid_fe.n_dofs_per_cell());
+    std::vector<double>                  local(fluid_fe.n_dofs_per_cell());
+    std::array<std::vector<double>, dim> velocity;
+    for (auto &v : velocity)
+      v.resize(dofs.velocity.size());
+    std::vector<double> pressure(dofs.pressure.size());
     for (const auto &cell : fluid_dof_handler.active_cell_iterators())
     {
       if (!cell->is_locally_owned())
@@ -187,27 +174,21 @@ namespace ImmersedGrains
       const bool owned = gather.gather(cell, fluid_solution, local);
       Assert(owned, dealii::ExcInternalError());
       (void)owned;
-      const dealii::Tensor<1, dim> extent =
-        cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1) -
-        cell->vertex(0);
-      double measure = 1;
-      for (unsigned int d = 0; d < dim; ++d)
-        measure *= extent[d];
+      for (unsigned int a = 0; a < dofs.velocity.size(); ++a)
+        for (unsigned int c = 0; c < dim; ++c)
+          velocity[c][a] = local[dofs.velocity[a][c]];
+      for (unsigned int b = 0; b < dofs.pressure.size(); ++b)
+        pressure[b] = local[dofs.pressure[b]];
+      velocity_shapes.reinit(cell, data.reference_points, false);
+      pressure_shapes.reinit(cell, data.reference_points, true);
+      filter_shapes.reinit(cell, data.reference_points, false);
       for (unsigned int q = 0; q < n_q; ++q)
       {
-        data.JxW[q] = quadrature.weight(q) * measure;
-        dealii::Tensor<1, dim> u, grad_p;
-        for (unsigned int a = 0; a < n_s; ++a)
-          for (unsigned int c = 0; c < dim; ++c)
-            u[c] += local[dofs.velocity[a][c]] * N[q * n_s + a];
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          for (unsigned int b = 0; b < n_p; ++b)
-            grad_p[d] += local[dofs.pressure[b]] * Gp[(q * dim + d) * n_p + b];
-          grad_p[d] /= extent[d];
-        }
-        data.velocity[q]          = u;
-        data.pressure_gradient[q] = grad_p;
+        data.JxW[q] =
+          quadrature.weight(q) * pressure_shapes.jacobian_determinant(q);
+        for (unsigned int c = 0; c < dim; ++c)
+          data.velocity[q][c] = velocity_shapes.value_of(velocity[c], q);
+        data.pressure_gradient[q] = pressure_shapes.gradient_of(pressure, q);
       }
       data.filter_cell = filter.dof_cell(cell);
       f(typename dealii::Triangulation<dim>::active_cell_iterator(cell), data);
@@ -264,7 +245,7 @@ namespace ImmersedGrains
                       for (unsigned int j = 0; j < n; ++j)
                       {
                         const double weight =
-                          data.filter_values[q * n + j] * data.JxW[q];
+                          data.filter_shapes->value(j, q) * data.JxW[q];
                         for (unsigned int d = 0; d < dim; ++d)
                           local_velocity[d](j) += data.velocity[q][d] * weight;
                         if (with_pressure_gradient)
@@ -444,17 +425,17 @@ namespace ImmersedGrains
                                     std::vector<double>();
                     for (unsigned int q = 0; q < data.JxW.size(); ++q)
                     {
-                      const double          *psi = &data.filter_values[q * n];
                       double                 a = 0, b = 0;
                       dealii::Tensor<1, dim> m;
                       for (unsigned int j = 0; j < n; ++j)
                       {
-                        a += local_alpha[j] * psi[j];
+                        const double psi = data.filter_shapes->value(j, q);
+                        a += local_alpha[j] * psi;
                         if (drag_as_field)
                         {
-                          b += local_beta[j] * psi[j];
+                          b += local_beta[j] * psi;
                           for (unsigned int d = 0; d < dim; ++d)
-                            m[d] += local_momentum[d][j] * psi[j];
+                            m[d] += local_momentum[d][j] * psi;
                         }
                       }
                       force -= (scale.empty() ? 1.0 : scale[q]) * a *

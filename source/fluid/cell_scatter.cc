@@ -62,6 +62,7 @@ namespace ImmersedGrains
     condensed_diagonals_start.clear();
     condensed_targets.clear();
     condensed_expansion_offsets.clear();
+    condensed_single_targets.clear();
     condensed_expansion.clear();
     condensed_diagonals.clear();
     condensed_row_lengths.clear();
@@ -400,6 +401,17 @@ namespace ImmersedGrains
     condensed_expansion.insert(condensed_expansion.end(),
                                expansion.begin(),
                                expansion.end());
+    // A free DoF's row or column is one target with weight 1: add_condensed()
+    // adds its entries straight to it.
+    for (unsigned int i = 0; i < dofs_per_cell; ++i)
+    {
+      const unsigned int end =
+        i + 1 < dofs_per_cell ? offsets[i + 1] : expansion.size();
+      condensed_single_targets.push_back(
+        end == offsets[i] + 1 && expansion[offsets[i]].weight == 1.0 ?
+          expansion[offsets[i]].target :
+          -1);
+    }
     condensed_diagonals_start.push_back(condensed_diagonals.size());
     condensed_diagonals.insert(condensed_diagonals.end(),
                                diagonals.begin(),
@@ -475,15 +487,10 @@ namespace ImmersedGrains
     // C^T K C and C^T f in the cell, over its target rows.
     condensed_matrix.assign(n_targets * n_targets, 0.0);
     condensed_rhs.assign(n_targets, 0.0);
-    // Most of a cell's DoFs are free: their row or column is one target
-    // with weight 1, and their entries go straight to it (the same sum:
-    // 1 * 1 * value is value).
-    single_target.resize(dofs_per_cell);
-    for (unsigned int i = 0; i < dofs_per_cell; ++i)
-      single_target[i] = offsets[i + 1] == offsets[i] + 1 &&
-                             condensed_expansion[offsets[i]].weight == 1.0 ?
-                           condensed_expansion[offsets[i]].target :
-                           -1;
+    // Most of a cell's DoFs are free: their entries go straight to their
+    // target (the same sum: 1 * 1 * value is value).
+    const int *single_target =
+      &condensed_single_targets[std::size_t(c) * dofs_per_cell];
     for (const Pair &pair : pairs)
     {
       const double value = cell_matrix(pair.i, pair.j);

@@ -128,17 +128,15 @@ namespace ImmersedGrains
     {
       std::vector<dealii::Tensor<1, dim>> velocity, pressure_gradient;
       std::vector<double>                 JxW;
-      // filter_values[q * n + j]: the filter's function j at point q.
-      std::vector<double>                                    filter_values;
+      // The filter's shape functions at the points.
+      const CellPointShapes<dim>                            *filter_shapes;
       std::vector<dealii::Point<dim>>                        reference_points;
       typename dealii::DoFHandler<dim>::active_cell_iterator filter_cell;
     };
 
-    // Calls @p f(cell, quadrature) on each locally owned cell. Every cell
-    // is an axis-parallel box (MappingCartesian), so the shape functions'
-    // values are the reference cell's and their gradients the reference
-    // gradients over the cell's extents: computed once per call, with the
-    // fluid's coefficients read through @p gather, instead of two
+    // Calls @p f(cell, quadrature) on each locally owned cell: the shape
+    // functions through CellPointShapes (reference values kept across
+    // cells) and the fluid's coefficients through @p gather, instead of two
     // FEValues::reinit and a look-up in Epetra's map per DoF and cell.
     template <typename F>
     void

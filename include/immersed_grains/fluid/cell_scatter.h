@@ -135,7 +135,8 @@ namespace ImmersedGrains
     std::vector<std::uint16_t> condensed_row_lengths; // entries per target row
     std::vector<Entry>         condensed_entries;
     mutable std::vector<double> condensed_matrix, condensed_rhs;
-    mutable std::vector<int>    single_target;
+    // Per condensed cell and local DoF: its one target if it is free, or -1.
+    std::vector<int> condensed_single_targets;
 
     // Records a cell for the condensed path; false if it does not qualify.
     bool
