@@ -7,7 +7,7 @@
 // (the component coupling of the fluid solver; a zero pressure diagonal in
 // some cells, where a constrained row takes the mean diagonal) and must
 // agree to round-off; serial and in parallel (.mpirun=2, where cells that
-// write other ranks' rows keep the general path).
+// write other ranks' rows add those rows through the non-local buffers).
 #include <deal.II/base/mpi.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_renumbering.h>

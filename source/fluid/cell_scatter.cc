@@ -75,6 +75,8 @@ namespace ImmersedGrains
       for (auto &values : row)
         values.clear();
     vector_values = {{nullptr, nullptr}};
+    matrix        = nullptr;
+    vector        = nullptr;
   }
 
 
@@ -106,12 +108,16 @@ namespace ImmersedGrains
     const dealii::DoFHandler<dim>                      &dof_handler,
     const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
     const dealii::AffineConstraints<double>            &constraints,
-    MatrixType                                         &matrix,
-    VectorType                                         &vector)
+    MatrixType                                         &system_matrix,
+    VectorType                                         &system_vector)
   {
     clear();
-    const auto &fe = dof_handler.get_fe();
-    dofs_per_cell  = fe.n_dofs_per_cell();
+    matrix             = &system_matrix;
+    vector             = &system_vector;
+    auto       &matrix = system_matrix;
+    auto       &vector = system_vector;
+    const auto &fe     = dof_handler.get_fe();
+    dofs_per_cell      = fe.n_dofs_per_cell();
     if (dofs_per_cell >= skip || matrix.n_block_rows() != 2 ||
         matrix.n_block_cols() != 2 || vector.n_blocks() != 2)
       return;
@@ -296,8 +302,8 @@ namespace ImmersedGrains
     std::vector<Expansion>    expansion;
     std::vector<unsigned int> offsets;
     std::vector<Diagonal>     diagonals;
-    // The index of @p dof among the targets, added if new; -1 if its row
-    // is not owned here or lies in another block than @p block.
+    // The index of @p dof among the targets, added if new; -1 if it lies
+    // in another block than @p block.
     const auto target_of = [&](const dealii::types::global_dof_index dof,
                                const unsigned int                    block,
                                const unsigned int component) -> int
@@ -305,14 +311,14 @@ namespace ImmersedGrains
       const auto known = std::find(target_dofs.begin(), target_dofs.end(), dof);
       if (known != target_dofs.end())
         return known - target_dofs.begin();
-      const int row = owned_row(dof);
-      if (row < 0 || blocks.global_to_local(dof).first != block ||
-          target_dofs.size() + 1 >= skip)
+      const auto [dof_block, index] = blocks.global_to_local(dof);
+      if (dof_block != block || target_dofs.size() + 1 >= skip)
         return -1;
       target_dofs.push_back(dof);
-      targets.push_back({row,
+      targets.push_back({owned_row(dof),
                          static_cast<std::uint8_t>(block),
-                         static_cast<std::uint16_t>(component)});
+                         static_cast<std::uint16_t>(component),
+                         index});
       return targets.size() - 1;
     };
 
@@ -339,13 +345,16 @@ namespace ImmersedGrains
           return false;
         expansion.push_back({static_cast<std::uint16_t>(t), weight});
       }
-      const int row = owned_row(dofs[i]);
-      if (row < 0 || blocks.global_to_local(dofs[i]).first != block)
+      const auto [dof_block, index] = blocks.global_to_local(dofs[i]);
+      if (dof_block != block)
         return false;
-      const std::uint16_t diagonal = position(block, row, dofs[i]);
-      if (diagonal == skip)
+      const int           row = owned_row(dofs[i]);
+      const std::uint16_t diagonal =
+        row < 0 ? skip : position(block, row, dofs[i]);
+      if (row >= 0 && diagonal == skip)
         return false;
-      diagonals.push_back({static_cast<std::uint16_t>(i), diagonal, row});
+      diagonals.push_back(
+        {static_cast<std::uint16_t>(i), diagonal, row, index});
     }
 
     // Each target's column in the blocks of both row blocks, looked up
@@ -366,6 +375,13 @@ namespace ImmersedGrains
         if (coupling(targets[a].component, targets[b].component) !=
             dealii::DoFTools::none)
         {
+          ++lengths[a];
+          // Another rank's row is added by global index.
+          if (targets[a].row < 0)
+          {
+            entries.push_back({static_cast<std::uint16_t>(b), skip});
+            continue;
+          }
           const unsigned int row_block = targets[a].block;
           const int          column    = columns[row_block][b];
           const int         *begin =
@@ -378,7 +394,6 @@ namespace ImmersedGrains
             return false;
           entries.push_back({static_cast<std::uint16_t>(b),
                              static_cast<std::uint16_t>(found - begin)});
-          ++lengths[a];
         }
 
     condensed_targets_start.push_back(condensed_targets.size());
@@ -523,10 +538,17 @@ namespace ImmersedGrains
       &condensed_row_lengths[condensed_targets_start[c]];
     for (std::size_t a = 0; a < n_targets; ++a)
     {
-      const Target &row       = targets[a];
+      const Target &row  = targets[a];
+      const double *sums = &condensed_matrix[a * n_targets];
+      if (row.row < 0)
+      {
+        add_to_remote_row(
+          row, entry, lengths[a], sums, targets, condensed_rhs[a]);
+        entry += lengths[a];
+        continue;
+      }
       double *const values[2] = {row_values[row.block][0][row.row],
                                  row_values[row.block][1][row.row]};
-      const double *sums      = &condensed_matrix[a * n_targets];
       for (unsigned int k = 0; k < lengths[a]; ++k, ++entry)
         values[targets[entry->column].block][entry->position] +=
           sums[entry->column];
@@ -545,11 +567,47 @@ namespace ImmersedGrains
     {
       const Diagonal    &diagonal = condensed_diagonals[d];
       const unsigned int block    = dof_block[diagonal.local_dof];
-      const double       value =
+      double             value =
         std::abs(cell_matrix(diagonal.local_dof, diagonal.local_dof));
-      row_values[block][block][diagonal.row][diagonal.position] +=
-        value != 0 ? value : mean;
+      value = value != 0 ? value : mean;
+      if (diagonal.row < 0)
+        matrix->block(block, block).add(diagonal.index, diagonal.index, value);
+      else
+        row_values[block][block][diagonal.row][diagonal.position] += value;
     }
+  }
+
+
+  template <int dim>
+  void
+  CellScatter<dim>::add_to_remote_row(const Target      &row,
+                                      const Entry       *entries,
+                                      const unsigned int n_entries,
+                                      const double      *sums,
+                                      const Target      *targets,
+                                      const double       rhs) const
+  {
+    for (unsigned int c = 0; c < 2; ++c)
+    {
+      remote_columns[c].clear();
+      remote_values[c].clear();
+    }
+    for (unsigned int k = 0; k < n_entries; ++k)
+    {
+      const Target &column = targets[entries[k].column];
+      remote_columns[column.block].push_back(column.index);
+      remote_values[column.block].push_back(sums[entries[k].column]);
+    }
+    for (unsigned int c = 0; c < 2; ++c)
+      if (!remote_columns[c].empty())
+        matrix->block(row.block, c)
+          .add(row.index,
+               remote_columns[c].size(),
+               remote_columns[c].data(),
+               remote_values[c].data(),
+               true,
+               false);
+    vector->block(row.block).add(1, &row.index, &rhs);
   }
 
 

@@ -39,8 +39,15 @@ namespace ImmersedGrains
    * weights from the cell's DoFs to those rows, and added at positions
    * found once per mesh; the constrained rows get the diagonal entry
    * AffineConstraints gives them. The sums are the same as
-   * distribute_local_to_global's, in another order (round-off). Cells with
-   * inhomogeneous constraints or rows of other ranks keep the general path.
+   * distribute_local_to_global's, in another order (round-off).
+   *
+   * On several ranks a cell next to another rank's cells writes rows that
+   * rank owns (a quarter of the cells of a 3D cloud on two ranks). Such a
+   * cell takes the condensed path too: its owned rows at their positions,
+   * the other rank's rows through the matrix's and vector's non-local
+   * buffers by global index, as distribute_local_to_global would, summed
+   * on their owner at compress(). Only cells with inhomogeneous
+   * constraints keep the general path.
    */
   template <int dim>
   class CellScatter
@@ -104,11 +111,15 @@ namespace ImmersedGrains
     // weights; each constrained local DoF's own row and the position of
     // its diagonal; and, target row by target row, the coupled target
     // columns with their positions. Offsets per cell into flat arrays.
+    // row: Epetra's local row, or -1 where another rank owns it; index:
+    // the global index in its block (of its column, and of a row that
+    // another rank owns).
     struct Target
     {
-      int           row;
-      std::uint8_t  block;
-      std::uint16_t component;
+      int                             row;
+      std::uint8_t                    block;
+      std::uint16_t                   component;
+      dealii::types::global_dof_index index;
     };
     struct Expansion
     {
@@ -117,9 +128,10 @@ namespace ImmersedGrains
     };
     struct Diagonal
     {
-      std::uint16_t local_dof;
-      std::uint16_t position;
-      int           row;
+      std::uint16_t                   local_dof;
+      std::uint16_t                   position; // skip: another rank's row
+      int                             row;
+      dealii::types::global_dof_index index; // in its block
     };
     struct Entry
     {
@@ -148,6 +160,15 @@ namespace ImmersedGrains
       const std::array<std::array<std::vector<int *>, 2>, 2> &row_indices,
       const std::array<std::array<std::vector<int>, 2>, 2>   &row_lengths);
 
+    // Adds a condensed cell's row that another rank owns (Target::row < 0).
+    void
+    add_to_remote_row(const Target &row,
+                      const Entry  *entries,
+                      unsigned int  n_entries,
+                      const double *sums,
+                      const Target *targets,
+                      double        rhs) const;
+
     void
     add_condensed(unsigned int                      c,
                   const dealii::FullMatrix<double> &cell_matrix,
@@ -167,6 +188,13 @@ namespace ImmersedGrains
     std::array<double *, 2>                             vector_values{};
     // The current cell's rows by local DoF and column block (add()).
     mutable std::vector<double *> row_pointers;
+
+    // Where rows that other ranks own are added (add_condensed()).
+    MatrixType *matrix = nullptr;
+    VectorType *vector = nullptr;
+    mutable std::array<std::vector<dealii::types::global_dof_index>, 2>
+                                               remote_columns;
+    mutable std::array<std::vector<double>, 2> remote_values;
   };
 } // namespace ImmersedGrains
 
