@@ -20,6 +20,9 @@
 // FLUID_BENCH_GEOMETRY sets the domain the preconditioner's constants were
 // not fitted on (they were fitted on the unit box, `unit`):
 //   column    a tall box 1 x 8 (x 1), the ball at 3/4 of its height;
+//   periodic_column, slip_column
+//             the same column with periodic or slip faces sideways (walls
+//             only at its ends);
 //   slab      a thin box 1 x 1/8 in 2D, 1 x 1 x 1/8 in 3D, with the ball
 //             replaced by a cylinder of radius 0.3 through its thickness;
 //   adaptive  the unit box at LEVEL_MIN, refined in a band around the
@@ -78,7 +81,7 @@ public:
     Point<dim>        c;
     for (unsigned int d = 0; d < dim; ++d)
       c[d] = 0.5;
-    if (geometry == "column")
+    if (geometry.find("column") != std::string::npos)
       c[1] = 6;
     if (std::getenv("FLUID_BENCH_ALIGNED") != nullptr)
     {
@@ -182,10 +185,18 @@ mesh_entries()
 {
   const std::string geometry = JumpField<dim>::bench_geometry();
   std::string       upper = "1, 1", subdivisions = "1, 1";
-  if (geometry == "column")
+  std::string       boundaries;
+  if (geometry == "column" || geometry == "periodic_column" ||
+      geometry == "slip_column")
   {
-    upper        = dim == 2 ? "1, 8" : "1, 8, 1";
-    subdivisions = dim == 2 ? "1, 8" : "1, 8, 1";
+    upper                  = dim == 2 ? "1, 8" : "1, 8, 1";
+    subdivisions           = dim == 2 ? "1, 8" : "1, 8, 1";
+    const std::string side = geometry == "periodic_column" ? "periodic" :
+                             geometry == "slip_column"     ? "slip" :
+                                                             "wall";
+    boundaries = "\n set Boundary conditions = " + side + ", " + side +
+                 ", wall, wall" +
+                 (dim == 3 ? ", " + side + ", " + side : std::string());
   }
   else if (geometry == "slab")
   {
@@ -195,7 +206,8 @@ mesh_entries()
   else
   {
     AssertThrow(geometry == "unit" || geometry == "adaptive",
-                ExcMessage("FLUID_BENCH_GEOMETRY: unit, column, slab or "
+                ExcMessage("FLUID_BENCH_GEOMETRY: unit, column, "
+                           "periodic_column, slip_column, slab or "
                            "adaptive, not " +
                            geometry));
     upper        = dim == 2 ? "1, 1" : "1, 1, 1";
@@ -204,7 +216,7 @@ mesh_entries()
   return "subsection Mesh\n set Lower corner = " +
          std::string(dim == 2 ? "0, 0" : "0, 0, 0") +
          "\n set Upper corner = " + upper +
-         "\n set Subdivisions = " + subdivisions + "\nend\n";
+         "\n set Subdivisions = " + subdivisions + boundaries + "\nend\n";
 }
 
 template <int dim>

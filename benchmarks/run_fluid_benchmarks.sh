@@ -31,7 +31,8 @@ if [ "${LARGE:-0}" = 1 ]; then
 fi
 # GEOMETRY=1: the domains the constants were not fitted on (doc/adaptivity.md,
 # "The fluid preconditioner on adaptive meshes"): an adaptive mesh around the
-# ball (levels 2-6 in 2D, 1-4 in 3D), a column 1 x 8 and a slab 8 x 1/8.
+# ball (levels 2-6 in 2D, 1-4 in 3D), a column 1 x 8 (walled all round, and
+# with periodic or slip sides) and a slab 8 x 1/8.
 if [ "${GEOMETRY:-0}" = 1 ]; then
   export FLUID_BENCH_DT=1,steady FLUID_BENCH_BETA=0,1e4,1e8
   FLUID_BENCH_GEOMETRY=adaptive $bin 2 2 6 > "$out/preconditioner_2d_adaptive.md"
@@ -40,6 +41,10 @@ if [ "${GEOMETRY:-0}" = 1 ]; then
   FLUID_BENCH_GEOMETRY=slab $bin 2 3 5 > "$out/preconditioner_2d_slab.md"
   FLUID_BENCH_GEOMETRY=column $bin 3 1 2 > "$out/preconditioner_3d_column.md"
   FLUID_BENCH_GEOMETRY=slab $bin 3 1 2 > "$out/preconditioner_3d_slab.md"
+  for sides in periodic_column slip_column; do
+    FLUID_BENCH_GEOMETRY=$sides $bin 2 3 5 > "$out/preconditioner_2d_$sides.md"
+    FLUID_BENCH_GEOMETRY=$sides $bin 3 1 2 > "$out/preconditioner_3d_$sides.md"
+  done
   unset FLUID_BENCH_DT FLUID_BENCH_BETA
 fi
 # INNER=1: the drag-jump columns with the inner GMRES on the velocity block

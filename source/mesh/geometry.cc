@@ -188,6 +188,29 @@ namespace ImmersedGrains
 
   template <int dim>
   double
+  Geometry<dim>::wall_gap() const
+  {
+    const auto no_slip = [&](const unsigned int face)
+    {
+      return boundary_types[face] == BoundaryType::wall ||
+             boundary_types[face] == BoundaryType::velocity;
+    };
+    double gap = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      const unsigned int walls =
+        (no_slip(2 * d) ? 1 : 0) + (no_slip(2 * d + 1) ? 1 : 0);
+      if (walls > 0)
+        gap = std::min(gap,
+                       (walls == 2 ? 1.0 : 2.0) *
+                         (upper_corner[d] - lower_corner[d]));
+    }
+    return gap < std::numeric_limits<double>::max() ? gap : shortest_side();
+  }
+
+
+  template <int dim>
+  double
   Geometry<dim>::shortest_cell_edge(const unsigned int level) const
   {
     double h = std::numeric_limits<double>::max();

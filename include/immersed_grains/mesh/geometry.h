@@ -62,6 +62,16 @@ namespace ImmersedGrains
     double
     longest_side() const;
 
+    /** The width of the gap between the no-slip faces (wall, velocity)
+     *  that confine the flow: per direction the side where both faces are
+     *  no-slip, twice it where one is (the other slip or open: a film,
+     *  half of a channel), nothing where neither is (periodic, slip,
+     *  open); the narrowest of these, or the shortest side where no face
+     *  is no-slip. The fluid preconditioner's Darcy floor is of the order
+     *  of mu over its square (fluid_assembly.cc). */
+    double
+    wall_gap() const;
+
     /** The shortest edge of the cells of refinement level @p level (the
      *  coarse mesh of `Subdivisions` is level 0). */
     double
