@@ -379,7 +379,7 @@ namespace ImmersedGrains
       // entries between different components would be stored zeros, a
       // third of the velocity block in 2D and two thirds in 3D, which every
       // product, ILU sweep and AMG set-up would carry.
-      const bool cross_components = parameters.newton && parameters.advection;
+      const bool cross_components = velocity_components_coupled();
       dealii::Table<2, dealii::DoFTools::Coupling> coupling(dim + 1, dim + 1);
       for (unsigned int c = 0; c < dim + 1; ++c)
         for (unsigned int d = 0; d < dim + 1; ++d)
@@ -559,6 +559,14 @@ namespace ImmersedGrains
     time              = 0;
     steps_done        = 0;
     max_initial_speed = owned.block(0).linfty_norm();
+  }
+
+
+  template <int dim>
+  bool
+  FluidSolver<dim>::velocity_components_coupled() const
+  {
+    return parameters.newton && parameters.advection;
   }
 
 

@@ -266,6 +266,12 @@ namespace ImmersedGrains
     void
     build_preconditioner();
 
+    // Whether the velocity block couples different components: only
+    // through Newton's derivative of the advection term (the slip faces of
+    // a box are normal to an axis and fix one component each).
+    bool
+    velocity_components_coupled() const;
+
     void
     normalize_pressure(VectorType &vector) const;
 
