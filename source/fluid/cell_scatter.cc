@@ -75,8 +75,8 @@ namespace ImmersedGrains
       for (auto &values : row)
         values.clear();
     vector_values = {{nullptr, nullptr}};
-    matrix        = nullptr;
-    vector        = nullptr;
+    system_matrix = nullptr;
+    system_vector = nullptr;
   }
 
 
@@ -108,16 +108,14 @@ namespace ImmersedGrains
     const dealii::DoFHandler<dim>                      &dof_handler,
     const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
     const dealii::AffineConstraints<double>            &constraints,
-    MatrixType                                         &system_matrix,
-    VectorType                                         &system_vector)
+    MatrixType                                         &matrix,
+    VectorType                                         &vector)
   {
     clear();
-    matrix             = &system_matrix;
-    vector             = &system_vector;
-    auto       &matrix = system_matrix;
-    auto       &vector = system_vector;
-    const auto &fe     = dof_handler.get_fe();
-    dofs_per_cell      = fe.n_dofs_per_cell();
+    system_matrix  = &matrix;
+    system_vector  = &vector;
+    const auto &fe = dof_handler.get_fe();
+    dofs_per_cell  = fe.n_dofs_per_cell();
     if (dofs_per_cell >= skip || matrix.n_block_rows() != 2 ||
         matrix.n_block_cols() != 2 || vector.n_blocks() != 2)
       return;
@@ -571,7 +569,8 @@ namespace ImmersedGrains
         std::abs(cell_matrix(diagonal.local_dof, diagonal.local_dof));
       value = value != 0 ? value : mean;
       if (diagonal.row < 0)
-        matrix->block(block, block).add(diagonal.index, diagonal.index, value);
+        system_matrix->block(block, block)
+          .add(diagonal.index, diagonal.index, value);
       else
         row_values[block][block][diagonal.row][diagonal.position] += value;
     }
@@ -600,14 +599,14 @@ namespace ImmersedGrains
     }
     for (unsigned int c = 0; c < 2; ++c)
       if (!remote_columns[c].empty())
-        matrix->block(row.block, c)
+        system_matrix->block(row.block, c)
           .add(row.index,
                remote_columns[c].size(),
                remote_columns[c].data(),
                remote_values[c].data(),
                true,
                false);
-    vector->block(row.block).add(1, &row.index, &rhs);
+    system_vector->block(row.block).add(1, &row.index, &rhs);
   }
 
 

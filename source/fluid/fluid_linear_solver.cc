@@ -108,8 +108,8 @@ namespace ImmersedGrains
     // the constant on every component, gives each aggregate the mode it
     // has: the same aggregates, the preconditioner benchmark's builds
     // 20-40 % and its solves 12-40 % cheaper for 0.8 % more iterations
-    // (doc/performance.md, eleventh round).
-    // (A rank without DoFs gets no modes from extract_constant_modes.)
+    // (doc/performance.md, eleventh round). A rank without DoFs gets no
+    // modes from extract_constant_modes.
     if (!velocity_components_coupled() &&
         !settings.velocity_constant_modes.empty())
     {

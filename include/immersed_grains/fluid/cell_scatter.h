@@ -190,8 +190,8 @@ namespace ImmersedGrains
     mutable std::vector<double *> row_pointers;
 
     // Where rows that other ranks own are added (add_condensed()).
-    MatrixType *matrix = nullptr;
-    VectorType *vector = nullptr;
+    MatrixType *system_matrix = nullptr;
+    VectorType *system_vector = nullptr;
     mutable std::array<std::vector<dealii::types::global_dof_index>, 2>
                                                remote_columns;
     mutable std::array<std::vector<double>, 2> remote_values;
