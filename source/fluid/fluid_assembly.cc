@@ -230,10 +230,15 @@ namespace ImmersedGrains
     const bool convection_derivative = terms.linearises_convection;
 
     dealii::FullMatrix<double> cell_matrix(dofs_per_cell, dofs_per_cell);
-    dealii::FullMatrix<double> cell_mass(dofs_per_cell, dofs_per_cell);
-    dealii::Vector<double>     cell_rhs(dofs_per_cell);
-    dealii::Vector<double>     cell_reaction(dofs_per_cell);
-    const double               wall_gap = geometry.wall_gap();
+    // The pressure mass matrix's cell part over the pressure DoFs alone:
+    // given the whole cell's matrix, distribute_local_to_global sorted and
+    // resolved all its rows, zeros included, at every preconditioner build
+    // (4 % of the 3D cloud's first steps).
+    dealii::FullMatrix<double>                   cell_mass(n_p, n_p);
+    std::vector<dealii::types::global_dof_index> pressure_indices(n_p);
+    dealii::Vector<double>                       cell_rhs(dofs_per_cell);
+    dealii::Vector<double>                       cell_reaction(dofs_per_cell);
+    const double                                 wall_gap = geometry.wall_gap();
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
     std::vector<double>                          local_solution(dofs_per_cell);
     std::vector<double> local_old(dofs_per_cell), local_older(dofs_per_cell);
@@ -542,12 +547,13 @@ namespace ImmersedGrains
           cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
       if (assemble_preconditioner_matrices)
       {
-        cell_mass     = 0;
         cell_reaction = 0;
         for (unsigned int b = 0; b < n_p; ++b)
+        {
+          pressure_indices[b] = dof_indices[pressure_dof[b]];
           for (unsigned int e = 0; e < n_p; ++e)
-            cell_mass(pressure_dof[b], pressure_dof[e]) =
-              integrals.Mp[b * n_p + e];
+            cell_mass(b, e) = integrals.Mp[b * n_p + e];
+        }
         for (unsigned int a = 0; a < n_s; ++a)
           for (unsigned int c = 0; c < dim; ++c)
             cell_reaction(velocity_dof[a][c]) = integrals.R[a];
@@ -555,7 +561,7 @@ namespace ImmersedGrains
           cell_mass *=
             drag_cell_mass_factor(cell_drag * h * h / cell_viscosity);
         pressure_mass_constraints.distribute_local_to_global(
-          cell_mass, dof_indices, pressure_mass_matrix);
+          cell_mass, pressure_indices, pressure_mass_matrix);
         update_constraints.distribute_local_to_global(cell_reaction,
                                                       dof_indices,
                                                       reaction_diagonal);
