@@ -35,6 +35,22 @@ namespace ImmersedGrains
                geometry.boundary_types[f] != BoundaryType::periodic;
       return w;
     }
+
+    template <int dim>
+    double
+    distance_to_box(const dealii::Point<dim>       &x,
+                    const dealii::BoundingBox<dim> &box)
+    {
+      double d2 = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double g = std::max({box.get_boundary_points().first[d] - x[d],
+                                   x[d] - box.get_boundary_points().second[d],
+                                   0.});
+        d2 += g * g;
+      }
+      return std::sqrt(d2);
+    }
   } // namespace
 
 
@@ -62,9 +78,11 @@ namespace ImmersedGrains
   template <int dim>
   void
   DistributedContacts<dim>::set_partition(
-    const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes)
+    const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes,
+    PartitionHalo                                             new_halo)
   {
     rank_boxes = boxes;
+    halo       = std::move(new_halo);
   }
 
 
@@ -111,8 +129,10 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  DistributedContacts<dim>::exchange_ghosts(Contact::GrainArrays<dim> &g,
-                                            const double               reach)
+  DistributedContacts<dim>::exchange_ghosts(
+    Contact::GrainArrays<dim>       &g,
+    const double                     reach,
+    const std::vector<unsigned int> &cells)
   {
     constexpr unsigned int spin_dim = (dim == 2 ? 1 : 3);
     // Decided together: a rank without grains has empty arrays but must
@@ -125,14 +145,40 @@ namespace ImmersedGrains
     send_lists.clear();
     recv_lists.clear();
     multiplicity.assign(n_owned, 1);
+    const bool by_cells = cells.size() == n_owned && halo.offsets.size() > 1;
     for (unsigned int i = 0; i < n_owned; ++i)
+    {
+      const double range = g.radius[i] + reach;
+      if (by_cells && range < halo.reach_limit)
+      {
+        // Only the other ranks' cells near this grain's: most grains have
+        // none. (One box per rank around a partition of an adapted mesh
+        // covers most of the domain, and with it every grain: each was
+        // then shared and mass splitting slowed every contact.)
+        const unsigned int c = cells[i];
+        Assert(c + 1 < halo.offsets.size(), dealii::ExcInternalError());
+        for (unsigned int e = halo.offsets[c]; e < halo.offsets[c + 1]; ++e)
+        {
+          const auto &[q, box] = halo.cells[e];
+          if (distance_to_box(all_positions[i], box) < range)
+          {
+            auto &list = send_lists[q];
+            if (list.empty() || list.back() != i)
+            {
+              list.push_back(i);
+              ++multiplicity[i];
+            }
+          }
+        }
+        continue;
+      }
       for (unsigned int q = 0; q < n_ranks; ++q)
-        if (q != my_rank &&
-            distance_to_rank(all_positions[i], q) < g.radius[i] + reach)
+        if (q != my_rank && distance_to_rank(all_positions[i], q) < range)
         {
           send_lists[q].push_back(i);
           ++multiplicity[i];
         }
+    }
 
     std::map<unsigned int, std::vector<double>> out;
     for (const auto &[q, list] : send_lists)
@@ -383,7 +429,8 @@ namespace ImmersedGrains
   DistributedContacts<dim>::solve(const std::vector<dealii::Point<dim>> &x,
                                   Contact::GrainArrays<dim>             &g,
                                   const double                           dt,
-                                  const double                           alert)
+                                  const double                           alert,
+                                  const std::vector<unsigned int>       &cells)
   {
     n_owned   = x.size();
     time_step = dt;
@@ -403,7 +450,7 @@ namespace ImmersedGrains
     r_max = dealii::Utilities::MPI::max(r_max, comm);
     if (n_ranks > 1)
     {
-      exchange_ghosts(g, r_max + alert);
+      exchange_ghosts(g, r_max + alert, cells);
       g.id = ids;
     }
 

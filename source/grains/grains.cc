@@ -1,6 +1,7 @@
 #include <deal.II/base/utilities.h>
 #include <deal.II/grid/filtered_iterator.h>
 #include <deal.II/grid/grid_tools.h>
+#include <deal.II/numerics/rtree.h>
 
 #include <immersed_grains/grains/grains.h>
 
@@ -168,7 +169,80 @@ namespace ImmersedGrains
         h = std::min(h, cell->minimum_vertex_distance());
     min_cell_size = dealii::Utilities::MPI::min(h, comm);
     if (contacts)
-      contacts->set_partition(rank_boxes);
+      contacts->set_partition(rank_boxes, make_contact_halo());
+  }
+
+
+  template <int dim>
+  typename DistributedContacts<dim>::PartitionHalo
+  Grains<dim>::make_contact_halo() const
+  {
+    typename DistributedContacts<dim>::PartitionHalo halo;
+    if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
+      return halo;
+    // The ghost cells, found near each owned cell through a tree of their
+    // boxes, the owned cell's box moved by a period where it lies within
+    // reach of a periodic face.
+    std::vector<std::pair<dealii::BoundingBox<dim>, unsigned int>> ghosts;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_ghost())
+        ghosts.emplace_back(cell->bounding_box(), cell->subdomain_id());
+    const auto   tree  = dealii::pack_rtree(ghosts);
+    const double reach = min_cell_size;
+    halo.reach_limit   = reach;
+    halo.offsets.assign(triangulation.n_active_cells() + 1, 0);
+    std::vector<std::pair<dealii::BoundingBox<dim>, unsigned int>> found;
+    for (const auto &cell : triangulation.active_cell_iterators())
+    {
+      const unsigned int c = cell->active_cell_index();
+      halo.offsets[c + 1]  = halo.offsets[c];
+      if (!cell->is_locally_owned())
+        continue;
+      auto corners = cell->bounding_box().get_boundary_points();
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        corners.first[d] -= reach;
+        corners.second[d] += reach;
+      }
+      // Every combination of periods on the periodic axes (0: none): a
+      // cell that reaches below the lower face looks for ghosts one period
+      // up, and the other way round.
+      std::vector<dealii::Tensor<1, dim>> shifts(1);
+      for (unsigned int d = 0; d < dim; ++d)
+        if (geometry.is_periodic(d))
+        {
+          const double L = geometry.upper_corner[d] - geometry.lower_corner[d];
+          const std::size_t n = shifts.size();
+          for (const double sign : {1., -1.})
+            if ((sign > 0 && corners.first[d] < geometry.lower_corner[d]) ||
+                (sign < 0 && corners.second[d] > geometry.upper_corner[d]))
+              for (std::size_t k = 0; k < n; ++k)
+              {
+                auto t = shifts[k];
+                t[d]   = sign * L;
+                shifts.push_back(t);
+              }
+        }
+      for (const auto &shift : shifts)
+      {
+        found.clear();
+        const dealii::BoundingBox<dim> query(
+          std::make_pair(corners.first + shift, corners.second + shift));
+        tree.query(boost::geometry::index::intersects(query),
+                   std::back_inserter(found));
+        for (const auto &[box, rank] : found)
+        {
+          // Into this cell's frame: a grain here measures its distance to
+          // the box without images.
+          const auto &[lo, hi] = box.get_boundary_points();
+          halo.cells.emplace_back(rank,
+                                  dealii::BoundingBox<dim>(
+                                    std::make_pair(lo - shift, hi - shift)));
+          ++halo.offsets[c + 1];
+        }
+      }
+    }
+    return halo;
   }
 
 
@@ -372,6 +446,9 @@ namespace ImmersedGrains
     auto &c = arrays.contact;
     arrays.position.resize(n);
     arrays.mass.resize(n);
+    const bool cells =
+      contacts && dealii::Utilities::MPI::n_mpi_processes(comm) > 1;
+    arrays.cell.resize(cells ? n : 0);
     arrays.fixed.resize(n);
     c.velocity.resize(n);
     c.start_velocity.resize(n);
@@ -396,6 +473,8 @@ namespace ImmersedGrains
     {
       const auto props   = p.get_properties();
       arrays.position[i] = p.get_location();
+      if (cells)
+        arrays.cell[i] = p.get_surrounding_cell()->active_cell_index();
       for (unsigned int d = 0; d < dim; ++d)
         c.velocity[i][d] = props[properties.velocity + d];
       c.radius[i]     = props[properties.radius];
@@ -568,8 +647,8 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> free_velocity;
     if (!arrays.contact_impulse.empty())
       free_velocity = c.velocity;
-    report.contacts =
-      contacts->solve(arrays.position, c, dt, report.alert_distance);
+    report.contacts = contacts->solve(
+      arrays.position, c, dt, report.alert_distance, arrays.cell);
     for (unsigned int i = 0; i < free_velocity.size(); ++i)
       arrays.contact_impulse[i] =
         (add_to_step_impulse ? arrays.contact_impulse[i] :

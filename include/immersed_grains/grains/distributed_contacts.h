@@ -32,7 +32,8 @@ namespace ImmersedGrains
    *
    *  - ghosts: each rank receives copies of the grains owned elsewhere that
    *    lie within reach (largest radius plus alert distance) of its own
-   *    cells' bounding boxes;
+   *    cells: of the cells themselves where the reach is shorter than every
+   *    cell (PartitionHalo), else of the box around them;
    *  - each contact is solved by exactly one rank, the lowest rank owning
    *    one of its grains;
    *  - a grain with copies on k ranks enters every copy's Delassus operator
@@ -53,18 +54,38 @@ namespace ImmersedGrains
   class DistributedContacts
   {
   public:
+    /**
+     * For each of this rank's cells, the other ranks' cells near it, as
+     * compressed rows by active cell index: cell c's are
+     * cells[offsets[c]] to cells[offsets[c + 1] - 1], each the owner rank
+     * and the cell's bounding box, moved by the period where it lies
+     * across a periodic face. They are this rank's ghost cells within
+     * reach_limit of the cell: a grain whose radius plus contact reach is
+     * below reach_limit (the shortest cell edge) can touch another rank's
+     * grain only in one of them, since every cell that close to one of
+     * this rank's cells shares a vertex with it, and all such cells are
+     * ghosts.
+     */
+    struct PartitionHalo
+    {
+      std::vector<unsigned int>                                      offsets;
+      std::vector<std::pair<unsigned int, dealii::BoundingBox<dim>>> cells;
+      double reach_limit = 0;
+    };
+
     DistributedContacts(const Geometry<dim>              &geometry,
                         const Contact::ContactParameters &parameters,
                         MPI_Comm                          comm);
 
     /**
-     * The bounding boxes of each rank's locally owned cells (all_gather of
-     * GridTools::compute_mesh_predicate_bounding_box); needed again after
-     * the mesh or its partition changes.
+     * The bounding boxes of each rank's locally owned cells, and the other
+     * ranks' cells near each of this rank's; needed again after the mesh or
+     * its partition changes.
      */
     void
     set_partition(
-      const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes);
+      const std::vector<std::vector<dealii::BoundingBox<dim>>> &boxes,
+      PartitionHalo                                             halo);
 
     /**
      * Gauss-Seidel visits the contacts in increasing x . @p direction on
@@ -79,12 +100,15 @@ namespace ImmersedGrains
      * Resolves the contacts of the owned grains at @p positions: grains go
      * in with free velocities and come out with end-of-step velocities.
      * The result holds global numbers (sums or maxima over ranks).
+     * @p cells holds each grain's active cell index, for the halo; empty:
+     * ghosts are found from the ranks' boxes alone.
      */
     Contact::SolverResult
     solve(const std::vector<dealii::Point<dim>> &positions,
           Contact::GrainArrays<dim>             &grains,
           double                                 time_step,
-          double                                 alert_distance);
+          double                                 alert_distance,
+          const std::vector<unsigned int>       &cells = {});
 
     /** Largest normal contact force of the last step, over all ranks. */
     double
@@ -113,6 +137,7 @@ namespace ImmersedGrains
     Contact::ContactSolver<dim> solver;
 
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
+    PartitionHalo                                      halo;
     dealii::Tensor<1, dim>                             sweep_direction;
 
     /// Local Gauss-Seidel sweeps between two glue exchanges (MPI only).
@@ -135,7 +160,9 @@ namespace ImmersedGrains
     distance_to_rank(const dealii::Point<dim> &x, unsigned int rank) const;
 
     void
-    exchange_ghosts(Contact::GrainArrays<dim> &grains, double reach);
+    exchange_ghosts(Contact::GrainArrays<dim>       &grains,
+                    double                           reach,
+                    const std::vector<unsigned int> &cells);
 
     void
     drop_ghosts(Contact::GrainArrays<dim> &grains) const;

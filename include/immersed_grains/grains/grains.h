@@ -62,6 +62,9 @@ namespace ImmersedGrains
   {
     std::vector<dealii::Point<dim>> position;
     std::vector<double>             mass;
+    /** Under MPI with contacts: each grain's active cell index, for the
+     *  contacts' halo (DistributedContacts::PartitionHalo); else empty. */
+    std::vector<unsigned int> cell;
     /** 1 for a fixed grain (never moved, infinite mass), else 0. */
     std::vector<unsigned char> fixed;
 
@@ -294,6 +297,10 @@ namespace ImmersedGrains
 
     GrainStepArrays<dim> arrays;
     unsigned long        removed_total = 0;
+
+    /** The other ranks' cells near each owned cell (update_partition()). */
+    typename DistributedContacts<dim>::PartitionHalo
+    make_contact_halo() const;
 
     /** A grain taken out of the ParticleHandler, to be put back into
      *  @p cell as it was. */
