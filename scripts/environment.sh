@@ -10,3 +10,7 @@ export CCACHE_DIR=${CCACHE_DIR:-$HOME/.ccache}
 # Paths relative to the checkout in ccache's hashes: a second clone (CI's
 # fresh one) reuses the objects of the first.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}
+# deal.II's flags carry -g, and with -g ccache hashes the build directory
+# (relative to the base directory; for the debug information's working
+# directory) unless told not to: build/ and build-dev/ shared no object.
+export CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
