@@ -36,6 +36,18 @@ namespace ImmersedGrains
       return w;
     }
 
+    /** Distance from @p y to the interval of @p box along axis @p d. */
+    template <int dim>
+    double
+    axis_gap(const dealii::BoundingBox<dim> &box,
+             const unsigned int              d,
+             const double                    y)
+    {
+      return std::max({box.get_boundary_points().first[d] - y,
+                       y - box.get_boundary_points().second[d],
+                       0.});
+    }
+
     template <int dim>
     double
     distance_to_box(const dealii::Point<dim>       &x,
@@ -43,12 +55,7 @@ namespace ImmersedGrains
     {
       double d2 = 0;
       for (unsigned int d = 0; d < dim; ++d)
-      {
-        const double g = std::max({box.get_boundary_points().first[d] - x[d],
-                                   x[d] - box.get_boundary_points().second[d],
-                                   0.});
-        d2 += g * g;
-      }
+        d2 += dealii::Utilities::fixed_power<2>(axis_gap(box, d, x[d]));
       return std::sqrt(d2);
     }
   } // namespace
@@ -108,16 +115,12 @@ namespace ImmersedGrains
       double d2 = 0;
       for (unsigned int d = 0; d < dim; ++d)
       {
-        const double lo  = box.get_boundary_points().first[d];
-        const double hi  = box.get_boundary_points().second[d];
-        const auto   gap = [&](const double y) {
-          return std::max({lo - y, y - hi, 0.});
-        };
-        double g = gap(x[d]);
+        double g = axis_gap(box, d, x[d]);
         if (geometry.is_periodic(d))
         {
           const double L = geometry.upper_corner[d] - geometry.lower_corner[d];
-          g              = std::min({g, gap(x[d] - L), gap(x[d] + L)});
+          g              = std::min(
+            {g, axis_gap(box, d, x[d] - L), axis_gap(box, d, x[d] + L)});
         }
         d2 += g * g;
       }
