@@ -196,8 +196,10 @@ namespace ImmersedGrains
       regime.warnings.push_back(
         "2D with Drag distribution = " + coupling_parameters.drag_distribution +
         ": a disc's own disturbance decays only logarithmically, and a lone "
-        "disc settles 2.4-4 times too fast whatever the cell "
-        "(doc/validation.md); use Drag distribution = filtered with "
+        "disc settles 2.4-4 times too fast whatever the cell; discs placed "
+        "at random settle about twice too fast, from the flows each cell's "
+        "random share of discs drives (doc/validation.md); use Drag "
+        "distribution = filtered with "
         "Smoothing length about half the box (2D suspensions then lie "
         "within 0.5 % of the closure)");
     if (two_way && !spread_in_cells && dim == 3 && l < 4 * d &&
