@@ -14,7 +14,9 @@ writes
                 evenly spaced); in 3D a second row shows only the grains
                 in a vertical slab through the centroid (|y - y_c| below a
                 fifth of the cloud's initial radius, --slab), where a torus
-                shows as two blobs with a gap between them;
+                shows as two blobs with a gap between them, and a third
+                row the cloud from below, where a torus shows as a ring
+                and its break-up as droplets along it;
   P_flow.png    at two instants: the pressure less its hydrostatic part
                 (colour) and the streamlines of the fluid velocity, with the
                 grains on top (by default the middle of the run and just
@@ -150,35 +152,43 @@ def frame(axes, centre, half_width):
 def plot_stages(directory, stats, times, half_width, out, groups, slab=0.0):
     particles = written_states(directory, "particles")
     n_grains = int(stats["particles"][0])
-    rows = 2 if VERTICAL == "z" else 1
+    rows = 3 if VERTICAL == "z" else 1
     figure, panels = plt.subplots(rows, len(times), squeeze=False,
                                   figsize=(2.6 * len(times), 3.0 * rows))
     for column, t in enumerate(times):
         t_state, pieces = nearest(particles, t)
-        x, ids = grains_at(pieces, with_ids=True, full=rows == 2)
+        x, ids = grains_at(pieces, with_ids=True, full=rows == 3)
         centre = centroid_at(stats, t_state)
         colour = np.array(["k", "tab:red", "tab:blue", "tab:green"])[
             group_of(ids, n_grains, groups) % 4]
         for row in range(rows):
             axes = panels[row][column]
             shown = np.ones(len(x), dtype=bool)
-            if rows == 2 and row == 1:
+            framed_on = centre
+            if rows == 3:
                 y_c = np.interp(t_state, stats["time"],
                                 stats["cloud_centroid_y"])
+            if rows == 3 and row == 1:
                 shown = np.abs(x[:, 1] - y_c) < slab
-            drawn = view(x[shown]) if rows == 2 else x
+            if rows == 3 and row == 2:
+                # From below, as the experiments photograph a torus.
+                drawn = x[:, :2]
+                framed_on = (centre[0], y_c)
+            else:
+                drawn = view(x[shown]) if rows == 3 else x
             axes.scatter(drawn[:, 0], drawn[:, 1],
                          s=1.2 if VERTICAL == "y" or row == 1 else 0.3,
                          c=colour[shown], edgecolors="none",
                          alpha=1 if VERTICAL == "y" or row == 1 else 0.4)
-            frame(axes, centre, half_width)
+            frame(axes, framed_on, half_width)
             if row == 0:
                 axes.set_title("t = %.3g s" % t_state, fontsize=10)
     panels[0][0].set_ylabel("%.2g mm frames on the centroid"
                             % (2e3 * half_width), fontsize=8)
-    if rows == 2:
+    if rows == 3:
         panels[1][0].set_ylabel("slab |y - y_c| < %.2g mm" % (1e3 * slab),
                                 fontsize=8)
+        panels[2][0].set_ylabel("from below (x, y)", fontsize=8)
     figure.tight_layout()
     figure.savefig(out, dpi=150)
     plt.close(figure)
