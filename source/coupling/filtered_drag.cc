@@ -5,8 +5,6 @@
 #include <immersed_grains/fluid/assembly_terms.h>
 #include <immersed_grains/fluid/cell_gather.h>
 
-#include <Epetra_MultiVector.h>
-
 namespace ImmersedGrains
 {
   template <int dim>
@@ -41,51 +39,6 @@ namespace ImmersedGrains
       velocity[d]          = filter.make_ghosted_vector();
       pressure_gradient[d] = filter.make_ghosted_vector();
     }
-    find_ghosted_positions();
-  }
-
-
-  template <int dim>
-  void
-  FilteredDrag<dim>::find_ghosted_positions()
-  {
-    const unsigned int n   = filter.get_fe().n_dofs_per_cell();
-    const auto        &map = beta.trilinos_vector().Map();
-    ghosted_length         = beta.trilinos_vector().MyLength();
-    positions.clear();
-    const auto &dof_handler = filter.get_dof_handler();
-    owned_number.assign(dof_handler.get_triangulation().n_active_cells(), -1);
-    int                                          owned = 0;
-    std::vector<dealii::types::global_dof_index> indices(n);
-    for (const auto &cell : dof_handler.active_cell_iterators())
-    {
-      if (!cell->is_locally_owned())
-        continue;
-      owned_number[cell->active_cell_index()] = owned++;
-      cell->get_dof_indices(indices);
-      for (unsigned int i = 0; i < n; ++i)
-      {
-        const int lid = map.LID(
-          static_cast<dealii::TrilinosWrappers::types::int_type>(indices[i]));
-        AssertThrow(lid >= 0,
-                    dealii::ExcMessage("FilteredDrag: a DoF of an owned cell "
-                                       "is not in the ghosted fields."));
-        positions.push_back(lid);
-      }
-    }
-  }
-
-
-  template <int dim>
-  const int *
-  FilteredDrag<dim>::ghosted_positions(
-    const unsigned int                           active_cell_index,
-    const typename HelmholtzFilter<dim>::Vector &field) const
-  {
-    const int k = owned_number[active_cell_index];
-    if (k < 0 || field.trilinos_vector().MyLength() != ghosted_length)
-      return nullptr;
-    return &positions[k * filter.get_fe().n_dofs_per_cell()];
   }
 
 
@@ -336,30 +289,17 @@ namespace ImmersedGrains
     const std::array<const typename HelmholtzFilter<dim>::Vector *, n_fields>
       &fields) const
   {
-    const unsigned int n = filter.get_fe().n_dofs_per_cell();
-    std::vector<dealii::types::global_dof_index> indices;
+    const auto         cell = filter.dof_cell(tria_cell);
+    const unsigned int n    = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::types::global_dof_index> indices(n);
+    cell->get_dof_indices(indices);
     shapes.reinit(tria_cell, reference_points, false);
     std::vector<double>                       local(n);
     std::array<std::vector<double>, n_fields> result;
     for (std::size_t f = 0; f < n_fields; ++f)
     {
-      if (const int *lid =
-            ghosted_positions(tria_cell->active_cell_index(), *fields[f]))
-      {
-        const double *data = fields[f]->trilinos_vector()[0];
-        for (unsigned int i = 0; i < n; ++i)
-          local[i] = data[lid[i]];
-      }
-      else
-      {
-        if (indices.empty())
-        {
-          indices.resize(n);
-          filter.dof_cell(tria_cell)->get_dof_indices(indices);
-        }
-        for (unsigned int i = 0; i < n; ++i)
-          local[i] = (*fields[f])[indices[i]];
-      }
+      for (unsigned int i = 0; i < n; ++i)
+        local[i] = (*fields[f])[indices[i]];
       result[f].resize(reference_points.size());
       for (unsigned int q = 0; q < reference_points.size(); ++q)
         result[f][q] = shapes.value_of(local, q);
@@ -458,20 +398,6 @@ namespace ImmersedGrains
   {
     const unsigned int n = filter.get_fe().n_dofs_per_cell();
     std::vector<dealii::types::global_dof_index> indices(n);
-    const auto                                   read_cell =
-      [&](const auto &cell, const auto &field, std::vector<double> &values)
-    {
-      if (const int *lid = ghosted_positions(cell->active_cell_index(), field))
-      {
-        const double *data = field.trilinos_vector()[0];
-        for (unsigned int j = 0; j < n; ++j)
-          values[j] = data[lid[j]];
-        return;
-      }
-      filter.dof_cell(cell)->get_dof_indices(indices);
-      for (unsigned int j = 0; j < n; ++j)
-        values[j] = field[indices[j]];
-    };
     // The filtered fields' coefficients on the cell: alpha, beta, m.
     std::vector<double>                  local_alpha(n), local_beta(n);
     std::array<std::vector<double>, dim> local_momentum;
@@ -483,12 +409,16 @@ namespace ImmersedGrains
                   fluid_solution,
                   [&](const auto &cell, const CellQuadrature &data)
                   {
-                    read_cell(cell, alpha, local_alpha);
-                    if (drag_as_field)
+                    data.filter_cell->get_dof_indices(indices);
+                    for (unsigned int j = 0; j < n; ++j)
                     {
-                      read_cell(cell, beta, local_beta);
-                      for (unsigned int d = 0; d < dim; ++d)
-                        read_cell(cell, momentum[d], local_momentum[d]);
+                      local_alpha[j] = alpha[indices[j]];
+                      if (drag_as_field)
+                      {
+                        local_beta[j] = beta[indices[j]];
+                        for (unsigned int d = 0; d < dim; ++d)
+                          local_momentum[d][j] = momentum[d][indices[j]];
+                      }
                     }
                     const std::vector<double> scale =
                       solid_scale ? solid_scale(cell, data.reference_points) :

@@ -152,21 +152,6 @@ namespace ImmersedGrains
       const std::vector<dealii::Point<dim>> &reference_points,
       const std::array<typename HelmholtzFilter<dim>::Vector, dim> &) const;
 
-    // Where each locally owned cell's filter DoFs lie in the ghosted
-    // fields (all of one layout): Epetra's map finds an index by hashing
-    // once the vector has ghosts from several ranks, and values_at() and
-    // force_on_fluid() read every field at every cell. Found once per
-    // mesh; nullptr for a cell that is not locally owned, or for a field
-    // of another layout.
-    void
-    find_ghosted_positions();
-    const int                  *
-    ghosted_positions(unsigned int active_cell_index,
-                                       const typename HelmholtzFilter<dim>::Vector &field) const;
-    std::vector<int> positions;    // per owned cell, per local DoF
-    std::vector<int> owned_number; // per active cell index: k, or -1
-    int              ghosted_length = -1;
-
     HelmholtzFilter<dim> filter;
 
     // The filter's Q1 shapes at the points last asked for.
