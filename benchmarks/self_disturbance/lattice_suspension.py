@@ -16,15 +16,15 @@ phi_s = 0.262 in a layer 60 r tall of a box 64 r x 64 r x 64 r, cells of
 sideways, closed above and below, steady Stokes, 12 steps of 0.5 s; the
 seed's beads in glycerine. About 1 min.
 """
-import csv
 import math
 import os
-import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-EXECUTABLE = os.path.join(ROOT, os.environ.get("IG_BUILD", "build"), "immersed-grains")
-WORK = os.path.join(ROOT, "benchmarks", "results", "lattice_suspension")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import scene_runner  # noqa: E402 (benchmarks/)
+
+WORK = os.path.join(scene_runner.ROOT, "benchmarks", "results",
+                    "lattice_suspension")
 R = 12.5e-6
 
 
@@ -44,8 +44,6 @@ def lattice(dim):
 
 
 def run(dim, placement, correction):
-    name = f"{dim}d_{placement}_{correction}"
-    out = os.path.join(WORK, name)
     n = len(lattice(dim))
     if dim == 2:
         box, cells, height = "1.6e-3, 1.6e-3", "4, 4", 1.6e-3
@@ -65,8 +63,7 @@ def run(dim, placement, correction):
     else:
         place = (f"set Shape = box\n    {region[0]}\n    {region[1]}\n"
                  f"    set Count = {n}\n    set Random seed = 3")
-    scene = f"""set Output directory = {out}
-set Dimension = {dim}
+    scene = f"""set Dimension = {dim}
 set End time  = 6
 set Time step = 0.5
 subsection Mesh
@@ -97,14 +94,9 @@ end
 subsection Gravity
   set Vector = {gravity}
 end
-subsection Output
-  set Terminal output = quiet
-end
 """
-    os.makedirs(WORK, exist_ok=True)
-    with open(out + ".prm", "w") as f:
-        f.write(scene)
-    subprocess.run([EXECUTABLE, out + ".prm"], check=True)
+    rows = scene_runner.run_scene(
+        scene, os.path.join(WORK, f"{dim}d_{placement}_{correction}"))
     # The closure in the grains' layer: v = eps^4.8 times the law's own
     # single-grain velocity (doc/theory.md section 3).
     width = 1.6e-3 if dim == 2 else 8e-4
@@ -112,7 +104,6 @@ end
     phi_s = n * volume / (width ** (dim - 1) * height)
     single = 4.1801e-6 if dim == 2 else 2 * 1200 * 9.81 * R * R / (9 * 0.12) / 0.96
     closure = -(1 - phi_s) ** 4.8 * single
-    rows = list(csv.DictReader(open(os.path.join(out, "statistics.csv"))))
     axis = "mean_velocity_" + ("y" if dim == 2 else "z")
     v = [float(r[axis]) / closure for r in rows if float(r["time"]) >= 3]
     return phi_s, sum(v) / len(v), min(v), max(v)
