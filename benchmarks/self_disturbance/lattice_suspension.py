@@ -51,7 +51,8 @@ def lattice(dim):
 
 
 def run(dim, placement, correction):
-    n = len(lattice(dim))
+    points = lattice(dim)
+    n = len(points)
     if dim == 2:
         box, cells, height = "1.6e-3, 1.6e-3", "4, 4", 1.6e-3
         faces = "periodic, periodic, wall, wall"
@@ -65,7 +66,7 @@ def run(dim, placement, correction):
                   "set Size   = 8e-4, 8e-4, 7.5e-4")
     if placement == "lattice":
         positions = "; ".join(", ".join(f"{x:.6g}" for x in p)
-                              for p in lattice(dim))
+                              for p in points)
         place = f"set Shape = list\n    set Positions = {positions}"
     else:
         place = (f"set Shape = box\n    {region[0]}\n    {region[1]}\n"
@@ -117,13 +118,12 @@ end
     # lid: in 3D the layer leaves its top and bottom cells partly filled.
     x, u = [], []
     for piece in glob.glob(os.path.join(directory, "particles_00012*.vtu")):
-        points, arrays, _ = read_vtu(piece)
-        if len(points):
-            x.append(points)
+        centres, arrays, _ = read_vtu(piece)
+        if len(centres):
+            x.append(centres)
             u.append(arrays["velocity"])
     x, u = np.concatenate(x), np.concatenate(u)
-    top = width if dim == 2 else 8e-4
-    inner = (x[:, dim - 1] > 1e-4) & (x[:, dim - 1] < top - 1e-4)
+    inner = (x[:, dim - 1] > 1e-4) & (x[:, dim - 1] < width - 1e-4)
     return phi_s, sum(v) / len(v), min(v), max(v), \
         u[inner, dim - 1].mean() / closure
 
