@@ -46,7 +46,8 @@ def main():
     parser.add_argument("--seeds", default="1",
                         help="placement seeds, comma separated")
     parser.add_argument("--ranks", type=int, default=1)
-    parser.add_argument("--out", default="/tmp/boycott_convergence")
+    parser.add_argument("--out", default=os.path.join(
+        ROOT, "benchmarks", "results", "boycott_convergence"))
     args = parser.parse_args()
 
     print("| cells across (cell / d) | time step | seed | mean v_y at "
