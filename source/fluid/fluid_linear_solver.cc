@@ -90,6 +90,7 @@ namespace ImmersedGrains
     settings.inner_iterations = parameters.velocity_inner_iterations;
     settings.inner_tolerance  = parameters.velocity_inner_tolerance;
     settings.pressure_mass_iterations = parameters.pressure_mass_iterations;
+    settings.pressure_mass_tolerance  = parameters.pressure_mass_tolerance;
     settings.velocity_aggregation_threshold = dim == 2 ? 0.05 : 0.02;
     // In 2D the coarse levels are light and ILU smooths them better (the
     // preconditioner benchmark: 1154 instead of 1130 iterations, 7 % more

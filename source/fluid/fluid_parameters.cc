@@ -237,10 +237,19 @@ namespace ImmersedGrains
           Integer(1, 100),
           "How the inverse of the phi/mu-weighted pressure mass matrix in the "
           "Schur complement approximation is applied: 1 is one ILU; N > 1 is "
-          "N conjugate-gradient iterations preconditioned by that ILU. On "
-          "several ranks the ILU is block-Jacobi, and a single one cost up "
-          "to 50% more outer iterations than on one rank "
-          "(doc/benchmarks.md).");
+          "at most N conjugate-gradient iterations preconditioned by that "
+          "ILU, stopped at Pressure mass tolerance. On several ranks the "
+          "ILU is block-Jacobi, and a single one cost up to 50% more outer "
+          "iterations than on one rank (doc/benchmarks.md).");
+        prm.declare_entry(
+          "Pressure mass tolerance",
+          "3e-4",
+          Double(0, 1),
+          "Relative residual at which the conjugate-gradient iterations of "
+          "Pressure mass iterations stop. Below it the outer iterations no "
+          "longer change; on one rank the ILU alone reaches it in most "
+          "scenes, and one iteration is done. 0: always Pressure mass "
+          "iterations (doc/performance.md).");
         prm.declare_entry(
           "Preconditioner rebuild ratio",
           "1.5",
@@ -330,6 +339,7 @@ namespace ImmersedGrains
           prm.get_integer("Velocity inner iterations");
         velocity_inner_tolerance = prm.get_double("Velocity inner tolerance");
         pressure_mass_iterations = prm.get_integer("Pressure mass iterations");
+        pressure_mass_tolerance  = prm.get_double("Pressure mass tolerance");
         preconditioner_rebuild_ratio =
           prm.get_double("Preconditioner rebuild ratio");
         where.require(velocity_inner_tolerance < 1,

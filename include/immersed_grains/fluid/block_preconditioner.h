@@ -45,9 +45,11 @@ namespace ImmersedGrains
       unsigned int inner_iterations = 0;
       double       inner_tolerance  = 1e-6;
 
-      // 1: M_w^{-1} is one ILU application; N > 1: N CG iterations
-      // preconditioned by the ILU.
+      // 1: M_w^{-1} is one ILU application; N > 1: CG preconditioned by
+      // the ILU until the relative residual is below
+      // pressure_mass_tolerance, at most N iterations.
       unsigned int pressure_mass_iterations = 3;
+      double       pressure_mass_tolerance  = 3e-4;
 
       // The AMG's aggregation threshold for A: the strength below which a
       // coupling is dropped when the aggregates are formed. 0.05 suits the
@@ -106,6 +108,11 @@ namespace ImmersedGrains
     mutable dealii::TrilinosWrappers::MPI::Vector velocity_residual;
     mutable dealii::TrilinosWrappers::MPI::Vector velocity_correction;
     mutable dealii::TrilinosWrappers::MPI::Vector pressure_tmp;
+    // The conjugate-gradient iteration of solve_pressure_mass().
+    mutable dealii::TrilinosWrappers::MPI::Vector cg_residual;
+    mutable dealii::TrilinosWrappers::MPI::Vector cg_preconditioned;
+    mutable dealii::TrilinosWrappers::MPI::Vector cg_direction;
+    mutable dealii::TrilinosWrappers::MPI::Vector cg_product;
   };
 } // namespace ImmersedGrains
 

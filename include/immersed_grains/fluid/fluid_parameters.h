@@ -84,6 +84,7 @@ namespace ImmersedGrains
     unsigned int velocity_inner_iterations    = 0;
     double       velocity_inner_tolerance     = 1e-6;
     unsigned int pressure_mass_iterations     = 3;
+    double       pressure_mass_tolerance      = 3e-4;
     double       preconditioner_rebuild_ratio = 1.5; // 0: every solve
 
     // Prescribed fields; shared so that a test can substitute exact ones.
