@@ -122,18 +122,30 @@ namespace ImmersedGrains
     for (auto &m : momentum_rhs)
       m.compress(dealii::VectorOperation::add);
 
+    std::vector<const typename HelmholtzFilter<dim>::Vector *> rhs;
+    std::vector<typename HelmholtzFilter<dim>::Vector *>       fields;
     if (implicit_velocity)
     {
-      filter.solve(alpha_rhs, alpha);
-      filter.solve(mobility_rhs, mobility);
+      rhs    = {&alpha_rhs, &mobility_rhs};
+      fields = {&alpha, &mobility};
       for (unsigned int d = 0; d < dim; ++d)
-        filter.solve(flux_rhs[d], free_flux[d]);
+      {
+        rhs.push_back(&flux_rhs[d]);
+        fields.push_back(&free_flux[d]);
+      }
     }
-    if (!drag_as_field)
-      return;
-    filter.solve(beta_rhs, beta);
-    for (unsigned int d = 0; d < dim; ++d)
-      filter.solve(momentum_rhs[d], momentum[d]);
+    if (drag_as_field)
+    {
+      rhs.push_back(&beta_rhs);
+      fields.push_back(&beta);
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        rhs.push_back(&momentum_rhs[d]);
+        fields.push_back(&momentum[d]);
+      }
+    }
+    if (!rhs.empty())
+      filter.solve(rhs, fields);
   }
 
 
@@ -266,17 +278,22 @@ namespace ImmersedGrains
                                                      pressure_rhs[d]);
                     }
                   });
+    std::vector<const typename HelmholtzFilter<dim>::Vector *> rhs;
+    std::vector<typename HelmholtzFilter<dim>::Vector *>       fields;
     for (unsigned int d = 0; d < dim; ++d)
     {
       velocity_rhs[d].compress(dealii::VectorOperation::add);
-      filter.solve(velocity_rhs[d], velocity[d]);
+      rhs.push_back(&velocity_rhs[d]);
+      fields.push_back(&velocity[d]);
     }
     if (with_pressure_gradient)
       for (unsigned int d = 0; d < dim; ++d)
       {
         pressure_rhs[d].compress(dealii::VectorOperation::add);
-        filter.solve(pressure_rhs[d], pressure_gradient[d]);
+        rhs.push_back(&pressure_rhs[d]);
+        fields.push_back(&pressure_gradient[d]);
       }
+    filter.solve(rhs, fields);
   }
 
 

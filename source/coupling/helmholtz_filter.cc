@@ -2,12 +2,15 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
-#include <deal.II/lac/solver_cg.h>
-#include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/sparsity_tools.h>
-#include <deal.II/lac/trilinos_precondition.h>
 
 #include <immersed_grains/coupling/helmholtz_filter.h>
+
+#include <Epetra_Map.h>
+#include <Epetra_MultiVector.h>
+#include <Epetra_Vector.h>
+
+#include <string>
 
 namespace ImmersedGrains
 {
@@ -123,6 +126,13 @@ namespace ImmersedGrains
     for (const auto i : owned)
       lumped_inverse[i] = row_sums[i] > 0 ? 1.0 / row_sums[i] : 0.0;
     lumped_inverse.compress(dealii::VectorOperation::insert);
+    diagonal_inverse.reinit(owned, comm);
+    for (const auto i : owned)
+    {
+      const double a      = matrix.diag_element(i);
+      diagonal_inverse[i] = a != 0 ? 1.0 / a : 1.0;
+    }
+    diagonal_inverse.compress(dealii::VectorOperation::insert);
     diagonal = lumped && length == 0;
   }
 
@@ -177,23 +187,97 @@ namespace ImmersedGrains
   void
   HelmholtzFilter<dim>::solve(const Vector &rhs, Vector &ghosted) const
   {
-    Vector x(owned, triangulation.get_communicator());
+    solve(std::vector<const Vector *>{&rhs}, std::vector<Vector *>{&ghosted});
+  }
+
+
+  template <int dim>
+  void
+  HelmholtzFilter<dim>::solve(const std::vector<const Vector *> &rhs,
+                              const std::vector<Vector *>       &ghosted) const
+  {
+    AssertDimension(rhs.size(), ghosted.size());
+    const unsigned int  n    = rhs.size();
+    const MPI_Comm      comm = triangulation.get_communicator();
+    std::vector<Vector> x(n, Vector(owned, comm));
     if (diagonal)
+      for (unsigned int c = 0; c < n; ++c)
+      {
+        x[c] = *rhs[c];
+        x[c].scale(lumped_inverse);
+      }
+    else if (owned.size() > 0)
     {
-      x = rhs;
-      x.scale(lumped_inverse);
+      // Jacobi-preconditioned conjugate gradients, column by column but in
+      // lockstep on Epetra multivectors. A tight tolerance: conservation
+      // is 1^T r away from exact, and the adjoint filter's momentum
+      // balance as far.
+      const Epetra_Map     &map = matrix.trilinos_matrix().RowMap();
+      std::vector<double *> x_columns(n);
+      for (unsigned int c = 0; c < n; ++c)
+        x_columns[c] = x[c].trilinos_vector()[0];
+      Epetra_MultiVector X(View, map, x_columns.data(), n);
+      Epetra_MultiVector R(map, n, false), Z(map, n, false), P(map, n, false),
+        AP(map, n, false);
+      for (unsigned int c = 0; c < n; ++c)
+        *R(c) = *rhs[c]->trilinos_vector()(0);
+      std::vector<double> stop(n), norm(n), r_dot_z(n), r_dot_z_new(n),
+        p_dot_ap(n);
+      R.Norm2(norm.data());
+      for (unsigned int c = 0; c < n; ++c)
+        stop[c] = 1e-15 * norm[c] + 1e-300;
+      std::vector<bool> active(n);
+      unsigned int      n_active = 0;
+      for (unsigned int c = 0; c < n; ++c)
+      {
+        active[c] = norm[c] > stop[c];
+        n_active += active[c];
+      }
+      const Epetra_MultiVector &D = diagonal_inverse.trilinos_vector();
+      Z.Multiply(1.0, D, R, 0.0);
+      P = Z;
+      R.Dot(Z, r_dot_z.data());
+      const unsigned int max_iterations = 1000;
+      for (unsigned int k = 0; k < max_iterations && n_active > 0; ++k)
+      {
+        matrix.trilinos_matrix().Multiply(false, P, AP);
+        P.Dot(AP, p_dot_ap.data());
+        for (unsigned int c = 0; c < n; ++c)
+          if (active[c])
+          {
+            const double alpha = r_dot_z[c] / p_dot_ap[c];
+            X(c)->Update(alpha, *P(c), 1.0);
+            R(c)->Update(-alpha, *AP(c), 1.0);
+          }
+        R.Norm2(norm.data());
+        for (unsigned int c = 0; c < n; ++c)
+          if (active[c] && norm[c] <= stop[c])
+          {
+            active[c] = false;
+            --n_active;
+          }
+        if (n_active == 0)
+          break;
+        AssertThrow(k + 1 < max_iterations,
+                    dealii::ExcMessage("The Helmholtz filter's conjugate "
+                                       "gradients did not converge in " +
+                                       std::to_string(max_iterations) +
+                                       " iterations."));
+        Z.Multiply(1.0, D, R, 0.0);
+        R.Dot(Z, r_dot_z_new.data());
+        for (unsigned int c = 0; c < n; ++c)
+          if (active[c])
+          {
+            P(c)->Update(1.0, *Z(c), r_dot_z_new[c] / r_dot_z[c]);
+            r_dot_z[c] = r_dot_z_new[c];
+          }
+      }
     }
-    else
+    for (unsigned int c = 0; c < n; ++c)
     {
-      // Tight tolerance: conservation is 1^T r away from exact.
-      dealii::SolverControl    control(1000, 1e-15 * rhs.l2_norm() + 1e-300);
-      dealii::SolverCG<Vector> cg(control);
-      dealii::TrilinosWrappers::PreconditionJacobi jacobi;
-      jacobi.initialize(matrix);
-      cg.solve(matrix, x, rhs, jacobi);
+      constraints.distribute(x[c]);
+      *ghosted[c] = x[c];
     }
-    constraints.distribute(x);
-    ghosted = x;
   }
 
 

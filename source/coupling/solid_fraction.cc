@@ -140,12 +140,17 @@ namespace ImmersedGrains
     for (auto &f : flux_rhs)
       f.compress(dealii::VectorOperation::add);
 
-    filter.solve(volume_rhs, fraction);
+    std::vector<const typename HelmholtzFilter<dim>::Vector *> rhs{&volume_rhs};
+    std::vector<typename HelmholtzFilter<dim>::Vector *> fields{&fraction};
     for (unsigned int d = 0; d < dim; ++d)
       if (with_flux)
-        filter.solve(flux_rhs[d], flux[d]);
+      {
+        rhs.push_back(&flux_rhs[d]);
+        fields.push_back(&flux[d]);
+      }
       else
         flux[d] = 0;
+    filter.solve(rhs, fields);
 
     if (parameters.smoothing_length > 0)
     {

@@ -76,6 +76,16 @@ namespace ImmersedGrains
     void
     solve(const Vector &rhs, Vector &f) const;
 
+    /**
+     * solve() for several right-hand sides at once: one conjugate-gradient
+     * iteration per column, in lockstep, so that each iteration reads the
+     * matrix once and reduces all inner products in one message. Each
+     * column stops at solve()'s tolerance.
+     */
+    void
+    solve(const std::vector<const Vector *> &rhs,
+          const std::vector<Vector *>       &f) const;
+
     /** The Q1 DoFHandler's cell of a triangulation cell. */
     typename dealii::DoFHandler<dim>::active_cell_iterator
     dof_cell(const typename dealii::Triangulation<dim>::active_cell_iterator
@@ -119,7 +129,10 @@ namespace ImmersedGrains
     dealii::TrilinosWrappers::SparseMatrix                   matrix;
     dealii::TrilinosWrappers::SparseMatrix                   mass_matrix;
     Vector                                                   lumped_inverse;
-    Vector                                                   weights;
+    // The inverse of the matrix's diagonal: the conjugate gradients' Jacobi
+    // preconditioner.
+    Vector diagonal_inverse;
+    Vector weights;
     // A plain lumped projection is a division, not a linear solve.
     bool diagonal = false;
   };
