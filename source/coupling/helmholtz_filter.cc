@@ -206,7 +206,7 @@ namespace ImmersedGrains
         x[c] = *rhs[c];
         x[c].scale(lumped_inverse);
       }
-    else if (owned.size() > 0)
+    else
     {
       // Jacobi-preconditioned conjugate gradients, column by column but in
       // lockstep on Epetra multivectors. A tight tolerance: conservation
