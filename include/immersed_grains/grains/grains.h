@@ -17,6 +17,7 @@
 
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace ImmersedGrains
@@ -328,6 +329,17 @@ namespace ImmersedGrains
       const typename dealii::Particles::ParticleHandler<dim>::particle_iterator
                                                                       &particle,
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell);
+
+    /** Among the locally owned cells that share a vertex with @p cell,
+     *  the one whose reference coordinates of @p x are closest to the unit
+     *  cell: that cell, the coordinates and their distance from the unit
+     *  cell (0 inside; infinite where no such cell is owned). */
+    std::tuple<typename dealii::Triangulation<dim>::active_cell_iterator,
+               dealii::Point<dim>,
+               double>
+    closest_owned_cell_around(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const dealii::Point<dim>                                        &x) const;
 
     /** Puts @p grains back into the ParticleHandler (local, no sort). */
     void
