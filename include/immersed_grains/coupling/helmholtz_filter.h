@@ -12,7 +12,11 @@
 
 #include <immersed_grains/mesh/geometry.h>
 
+#include <memory>
 #include <vector>
+
+class Amesos_BaseSolver;
+class Epetra_LinearProblem;
 
 namespace ImmersedGrains
 {
@@ -41,6 +45,8 @@ namespace ImmersedGrains
 
     HelmholtzFilter(const dealii::parallel::distributed::Triangulation<dim> &,
                     const Geometry<dim> &geometry);
+
+    ~HelmholtzFilter();
 
     /**
      * (Re)builds DoFs and the matrix; call after every mesh change. The
@@ -72,7 +78,9 @@ namespace ImmersedGrains
     void
     mass_product(const Vector &f, Vector &rhs) const;
 
-    /** Solves A f = @p rhs (compressed, owned) into the ghosted @p f. */
+    /** Solves A f = @p rhs (compressed, owned) into the ghosted @p f: with
+     *  the factorisation of setup() where there is one, else by
+     *  conjugate gradients to a relative residual of 1e-15. */
     void
     solve(const Vector &rhs, Vector &f) const;
 
@@ -135,6 +143,10 @@ namespace ImmersedGrains
     Vector weights;
     // A plain lumped projection is a division, not a linear solve.
     bool diagonal = false;
+    // On one rank and up to direct_limit() unknowns, A's sparse LU
+    // (setup()); solve() then costs two triangular solves per field.
+    std::unique_ptr<Epetra_LinearProblem> direct_problem;
+    std::unique_ptr<Amesos_BaseSolver>    direct_solver;
   };
 } // namespace ImmersedGrains
 
