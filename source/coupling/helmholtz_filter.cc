@@ -38,10 +38,12 @@ namespace ImmersedGrains
     // The most unknowns for which one rank factorises the filter's matrix
     // (doc/performance.md, fourteenth round). In 2D the factors of this
     // Laplacian-like matrix grow like n log n, and their triangular solves
-    // took a third of the time of the 25-30 Jacobi-CG iterations on the 2D
-    // cloud's 2,145 unknowns and on 33,000. In 3D they grow like n^(4/3):
-    // on the 3D cloud's 4,913 unknowns the solves took twice the CG's
-    // time, which the mass-like matrix keeps short there.
+    // beat the 25-30 Jacobi-CG iterations: the solid fraction's and the
+    // interaction force's phases took a third less time on the 2D cloud's
+    // 2,145 unknowns and two thirds to five sixths less on 33,000. In 3D
+    // they grow like n^(4/3): on the 3D cloud's 4,913 unknowns the solid
+    // fraction took twice the CG's time, which the mass-like matrix keeps
+    // short there.
     constexpr unsigned int
     direct_limit(const int dim)
     {
