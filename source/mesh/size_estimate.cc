@@ -32,8 +32,11 @@ namespace ImmersedGrains
       const double bytes_per_cell  = 1e3; // p4est, Triangulation, grain sorting
       // With a fluid, the positions of each cell matrix's entries in the
       // matrix rows (CellScatter: 2 bytes per coupled pair of the Q2-Q1
-      // cell's DoFs, 4 per DoF): 0.7 kB in 2D, 7.5 kB in 3D.
-      const double bytes_per_fluid_cell = dim == 2 ? 0.75e3 : 7.5e3;
+      // cell's DoFs, 4 per DoF): 0.7 kB in 2D, 7.5 kB in 3D. In 2D on one
+      // rank, the Helmholtz filter's sparse LU besides (one Q1 unknown per
+      // cell): 380 MB at 131,072 cells, 2.9 kB per cell, growing like
+      // log n; counted on any number of ranks, an estimate errs high.
+      const double bytes_per_fluid_cell = dim == 2 ? 0.75e3 + 3e3 : 7.5e3;
 
       SizeEstimate e;
       e.cells = cells;
