@@ -5,6 +5,8 @@ drawn from the side, x across and z up, and have no flow figure):
     /usr/bin/python3 scripts/plot_cloud.py OUTPUT_DIR [--out-prefix P]
         [--stages t1,t2,t3,t4,t5] [--flow t1,t2] [--half-width W]
         [--groups N] [--reference-velocity U]
+    /usr/bin/python3 scripts/plot_cloud.py OUTPUT_DIR --clusters t1,t2,...
+        [--link-distance L] [--core-neighbours N]
 
 writes
   P_stages.png  the grains at five instants side by side, each framed on
@@ -388,6 +390,78 @@ def front_maxima(directory, stats, radius, out):
            if split is not None else "one maximum throughout"))
 
 
+def clusters_of(x, diameter, link, core):
+    """The cloud analysis's clusters (doc/theory.md): grains closer than
+    @p link diameters are linked; a grain with at least @p core linked
+    neighbours is a core grain; clusters grow from core grains, and other
+    grains join the cluster of a core grain they are linked to. Returns a
+    label per grain, -1 for grains in no cluster."""
+    cut = link * diameter
+    keys = np.floor(x / cut).astype(np.int64)
+    buckets = {}
+    for i, key in enumerate(map(tuple, keys)):
+        buckets.setdefault(key, []).append(i)
+    offsets = np.array(np.meshgrid(*[[-1, 0, 1]] * x.shape[1])).reshape(
+        x.shape[1], -1).T
+    neighbours = [None] * len(x)
+    for key, members in buckets.items():
+        near = np.array([j for o in offsets
+                         for j in buckets.get(tuple(np.add(key, o)), [])])
+        for i in members:
+            close = np.sum((x[near] - x[i]) ** 2, axis=1) < cut * cut
+            neighbours[i] = near[close & (near != i)]
+    is_core = np.array([len(n) >= core for n in neighbours])
+    label = -np.ones(len(x), dtype=int)
+    count = 0
+    for start in np.flatnonzero(is_core):
+        if label[start] >= 0:
+            continue
+        label[start] = count
+        stack = [start]
+        while stack:
+            for j in neighbours[stack.pop()]:
+                if label[j] < 0:
+                    label[j] = count
+                    if is_core[j]:
+                        stack.append(j)
+        count += 1
+    return label
+
+
+def print_clusters(directory, times, link, core):
+    """A table of the clusters at the written states nearest to @p times:
+    their sizes, largest first, and in 3D the azimuthal sectors (15
+    degrees, from +x towards +y around the vertical through the grains'
+    centroid) that each of the three largest occupies."""
+    states = written_states(directory, "particles")
+    print("t [s] | grains | clusters of >= 20 % | next largest | in none")
+    sectors = []
+    for t in times:
+        time, pieces = nearest(states, t)
+        x = grains_at(pieces, full=True)
+        radius = np.concatenate([read_vtu(p)[1]["radius"] for p in pieces])
+        label = clusters_of(x[:, :3 if VERTICAL == "z" else 2],
+                            2 * radius.max(), link, core)
+        sizes = np.bincount(label[label >= 0])
+        order = np.argsort(-sizes)
+        large = [int(sizes[k]) for k in order if sizes[k] >= 0.2 * len(x)]
+        rest = [int(sizes[k]) for k in order[len(large):len(large) + 5]]
+        print("%.3f | %d | %s | %s | %d" % (time, len(x), large, rest,
+                                            int(np.sum(label < 0))))
+        if VERTICAL == "z":
+            c = x.mean(axis=0)
+            angle = np.degrees(np.arctan2(x[:, 1] - c[1], x[:, 0] - c[0]))
+            for k in order[:3]:
+                counts = np.histogram(angle[label == k] % 360, bins=24,
+                                      range=(0, 360))[0]
+                sectors.append("%.3f  %5d: %s" % (
+                    time, sizes[k], " ".join("%d" % n for n in counts)))
+    if sectors:
+        print("beads per 15-degree sector (0-15, 15-30, ...), three largest "
+              "clusters:")
+        print("\n".join(sectors))
+
+
 def times_option(text, count, name):
     if text is None:
         return None
@@ -417,9 +491,24 @@ def main():
     parser.add_argument("--half-width", type=float,
                         help="half the side of each frame [m] (default: "
                         "six times the cloud's initial radius of gyration)")
+    parser.add_argument("--clusters", help="times, comma separated: print "
+                        "the clusters at the written states nearest to them "
+                        "(sizes; in 3D the sectors around the axis each "
+                        "occupies) instead of drawing")
+    parser.add_argument("--link-distance", type=float, default=3,
+                        help="with --clusters: Cloud analysis/Link distance "
+                        "[diameters]")
+    parser.add_argument("--core-neighbours", type=int, default=4,
+                        help="with --clusters: Cloud analysis/Core "
+                        "neighbours")
     args = parser.parse_args()
 
     stats = read_statistics(args.directory)
+    if args.clusters:
+        times = [float(t) for t in args.clusters.split(",")]
+        print_clusters(args.directory, times, args.link_distance,
+                       args.core_neighbours)
+        return
     prefix = args.out_prefix or os.path.join(args.directory, "cloud")
     end = stats["time"][-1]
     breakup = stats["breakup_time"][-1]
