@@ -463,10 +463,16 @@ def print_clusters(directory, times, link, core):
 
 
 def times_option(text, count, name):
+    """The comma-separated times of option @p name: @p count of them, or
+    any number if @p count is None."""
     if text is None:
         return None
-    values = [float(v) for v in text.split(",")]
-    if len(values) != count:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        sys.exit("plot_cloud.py: %s takes times in seconds, comma "
+                 "separated, not '%s'" % (name, text))
+    if count is not None and len(values) != count:
         sys.exit("plot_cloud.py: %s needs %d times" % (name, count))
     return values
 
@@ -505,7 +511,7 @@ def main():
 
     stats = read_statistics(args.directory)
     if args.clusters:
-        times = [float(t) for t in args.clusters.split(",")]
+        times = times_option(args.clusters, None, "--clusters")
         print_clusters(args.directory, times, args.link_distance,
                        args.core_neighbours)
         return
