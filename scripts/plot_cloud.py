@@ -438,8 +438,9 @@ def print_clusters(directory, times, link, core):
     sectors = []
     for t in times:
         time, pieces = nearest(states, t)
-        x = grains_at(pieces, full=True)
-        radius = np.concatenate([read_vtu(p)[1]["radius"] for p in pieces])
+        read = [read_vtu(p) for p in pieces]
+        x = np.concatenate([r[0] for r in read])
+        radius = np.concatenate([r[1]["radius"] for r in read])
         label = clusters_of(x[:, :3 if VERTICAL == "z" else 2],
                             2 * radius.max(), link, core)
         sizes = np.bincount(label[label >= 0])

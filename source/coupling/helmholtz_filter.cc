@@ -152,18 +152,13 @@ namespace ImmersedGrains
     for (const auto i : owned)
       lumped_inverse[i] = row_sums[i] > 0 ? 1.0 / row_sums[i] : 0.0;
     lumped_inverse.compress(dealii::VectorOperation::insert);
-    diagonal_inverse.reinit(owned, comm);
-    for (const auto i : owned)
-    {
-      const double a      = matrix.diag_element(i);
-      diagonal_inverse[i] = a != 0 ? 1.0 / a : 1.0;
-    }
-    diagonal_inverse.compress(dealii::VectorOperation::insert);
     diagonal = lumped && length == 0;
 
     direct_solver.reset();
     direct_problem.reset();
-    if (!diagonal && dealii::Utilities::MPI::n_mpi_processes(comm) == 1 &&
+    if (diagonal)
+      return;
+    if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1 &&
         dof_handler.n_dofs() <= direct_limit(dim))
     {
       direct_problem = std::make_unique<Epetra_LinearProblem>();
@@ -177,6 +172,17 @@ namespace ImmersedGrains
                     direct_solver->NumericFactorization() == 0,
                   dealii::ExcMessage(
                     "the Helmholtz filter's matrix could not be factorised"));
+    }
+    else
+    {
+      // The conjugate gradients' Jacobi preconditioner.
+      diagonal_inverse.reinit(owned, comm);
+      for (const auto i : owned)
+      {
+        const double a      = matrix.diag_element(i);
+        diagonal_inverse[i] = a != 0 ? 1.0 / a : 1.0;
+      }
+      diagonal_inverse.compress(dealii::VectorOperation::insert);
     }
   }
 

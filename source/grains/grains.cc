@@ -699,7 +699,6 @@ namespace ImmersedGrains
     // are outside [0, 1] by round-off, and one sitting exactly on a mesh
     // vertex was lost so. Where other grains move, the fixed ones leave
     // the ParticleHandler during the sort and return to their cells.
-    std::vector<StoredGrain>       held;
     std::vector<particle_iterator> leaving, taken_out;
     // A grain that left its cell for an owned cell around it is moved
     // there directly; the library's sort (every grain's cell tested again,
@@ -811,14 +810,7 @@ namespace ImmersedGrains
       {
         ++n_fixed;
         if (parameters.has_fixed_region)
-        {
-          held.push_back({p->get_surrounding_cell(),
-                          p->get_location(),
-                          p->get_reference_location(),
-                          p->get_id(),
-                          std::vector<double>(props.begin(), props.end())});
           taken_out.push_back(p);
-        }
       }
     }
     const unsigned long n_leaving = leaving.size();
@@ -838,6 +830,18 @@ namespace ImmersedGrains
     }
     else
     {
+      // Copied only here: where no grain left its neighbourhood the fixed
+      // ones stay in the ParticleHandler.
+      std::vector<StoredGrain> held;
+      for (const auto &p : taken_out)
+      {
+        const auto props = p->get_properties();
+        held.push_back({p->get_surrounding_cell(),
+                        p->get_location(),
+                        p->get_reference_location(),
+                        p->get_id(),
+                        std::vector<double>(props.begin(), props.end())});
+      }
       leaving.insert(leaving.end(), taken_out.begin(), taken_out.end());
       particles.remove_particles(leaving);
       rescued.clear();
