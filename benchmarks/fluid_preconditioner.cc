@@ -23,6 +23,10 @@
 //   periodic_column, slip_column
 //             the same column with periodic or slip faces sideways (walls
 //             only at its ends);
+//   bed_column
+//             the walled column with the low fluid fraction in a layer
+//             across it, |y - 6| < 0.5 (a packed bed that the flow must
+//             cross);
 //   slab      a thin box 1 x 1/8 in 2D, 1 x 1 x 1/8 in 3D, with the ball
 //             replaced by a cylinder of radius 0.3 through its thickness;
 //   adaptive  the unit box at LEVEL_MIN, refined in a band around the
@@ -78,6 +82,8 @@ public:
   is_inside(const Point<dim> &x)
   {
     const std::string geometry = bench_geometry();
+    if (geometry == "bed_column")
+      return std::abs(x[1] - 6) < 0.5;
     Point<dim>        c;
     for (unsigned int d = 0; d < dim; ++d)
       c[d] = 0.5;
@@ -187,7 +193,7 @@ mesh_entries()
   std::string       upper = "1, 1", subdivisions = "1, 1";
   std::string       boundaries;
   if (geometry == "column" || geometry == "periodic_column" ||
-      geometry == "slip_column")
+      geometry == "slip_column" || geometry == "bed_column")
   {
     upper                  = dim == 2 ? "1, 8" : "1, 8, 1";
     subdivisions           = dim == 2 ? "1, 8" : "1, 8, 1";
@@ -306,8 +312,10 @@ run(const unsigned int level_min,
             fluid.solve_time_step(dt > 0 ? dt : 1.0, dt > 0 ? dt : 1.0)
               .linear_iterations;
         }
-        catch (const std::exception &)
+        catch (const std::exception &e)
         {
+          if (std::getenv("FLUID_BENCH_VERBOSE") != nullptr)
+            std::cerr << e.what() << std::endl;
           converged = false;
         }
         const double seconds = std::chrono::duration<double>(

@@ -2,11 +2,14 @@
 #include <deal.II/lac/solver_gmres.h>
 
 #include <immersed_grains/fluid/block_preconditioner.h>
+#include <immersed_grains/fluid/coarse_schur_correction.h>
 
 #include <Epetra_MultiVector.h>
 #include <Teuchos_ParameterList.hpp>
 
+#include <cstdlib>
 #include <memory>
+#include <string>
 
 namespace ImmersedGrains
 {
@@ -14,10 +17,12 @@ namespace ImmersedGrains
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
     const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass,
     const dealii::TrilinosWrappers::SparseMatrix      *pressure_laplace,
-    const Settings                                    &settings)
+    const Settings                                    &settings,
+    const CoarseSchurCorrection                       *coarse)
       : system_matrix(system_matrix)
       , settings(settings)
       , pressure_mass(pressure_mass)
+      , coarse(coarse)
   {
     if (settings.velocity_ilu)
     {
@@ -97,6 +102,32 @@ namespace ImmersedGrains
 
   void
   BlockSchurPreconditioner::vmult(VectorType &dst, const VectorType &src) const
+  {
+    if (coarse != nullptr)
+    {
+      // Two levels: the coarse saddle point system first, then the block
+      // preconditioner on the residual it leaves (a multiplicative
+      // correction; applied after instead, or on both sides, it took as
+      // many or more outer iterations, doc/adaptivity.md).
+      if (coarse_correction.n_blocks() == 0)
+      {
+        coarse_correction.reinit(src);
+        coarse_residual.reinit(src);
+      }
+      coarse->vmult(coarse_correction, src);
+      system_matrix.vmult(coarse_residual, coarse_correction);
+      coarse_residual.sadd(-1.0, 1.0, src);
+      apply_block(dst, coarse_residual);
+      dst += coarse_correction;
+      return;
+    }
+    apply_block(dst, src);
+  }
+
+
+  void
+  BlockSchurPreconditioner::apply_block(VectorType       &dst,
+                                        const VectorType &src) const
   {
     // Pressure: -S~^{-1} g.
     dst.block(1) = 0;

@@ -8,9 +8,11 @@
 #include <deal.II/lac/trilinos_vector.h>
 
 #include <immersed_grains/fluid/block_preconditioner.h>
+#include <immersed_grains/fluid/coarse_schur_correction.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 
 #include <cmath>
+#include <limits>
 
 #include <cstdlib>
 #include <sstream>
@@ -130,6 +132,35 @@ namespace ImmersedGrains
     // catches them: a 1 x 8 column 38-46 -> 27-32 outer iterations, a
     // 1 x 1/8 slab 22-33 -> 16-31 (2D and 3D, levels 1-5; doc/adaptivity.md).
     // In a cube it only adds error (2D level 6: 21 -> 30), hence the gate.
+    // The two-level correction: its coarse space once per mesh, its
+    // operators with every preconditioner.
+    const int coarse_level = coarse_correction_level();
+    if (coarse_level >= 0)
+    {
+      if (!coarse_schur)
+        coarse_schur =
+          std::make_unique<CoarseSchurCorrection>(dof_handler,
+                                                  update_constraints,
+                                                  geometry,
+                                                  coarse_level,
+                                                  owned_partitioning,
+                                                  mpi_communicator);
+      // The coarse space spans the velocities where the viscous part of
+      // A's diagonal exceeds the mass and drag part (with its floor, at
+      // most 0.3 of the viscous part): where mass or drag dominate, the
+      // velocity is local and the coarse functions would carry the drag
+      // across the region's edge (doc/adaptivity.md).
+      const auto                           &A = system_matrix.block(0, 0);
+      dealii::TrilinosWrappers::MPI::Vector weight(owned_partitioning[0],
+                                                   mpi_communicator);
+      for (const auto i : owned_partitioning[0])
+        weight[i] =
+          reaction_diagonal.block(0)[i] < 0.5 * std::abs(A.diag_element(i)) ?
+            1.0 :
+            0.0;
+      weight.compress(dealii::VectorOperation::insert);
+      coarse_schur->build(system_matrix, weight, pressure_has_null_space());
+    }
     const bool long_modes =
       !parameters.time_derivative && !schur_has_drag &&
       geometry.longest_side() >= 2 * geometry.shortest_side();
@@ -239,7 +270,8 @@ namespace ImmersedGrains
       (mass_term || !laplace_term) ? &pressure_mass_matrix.block(1, 1) :
                                      nullptr,
       laplace_term ? &schur_diagonal_matrix : nullptr,
-      settings);
+      settings,
+      coarse_level >= 0 ? coarse_schur.get() : nullptr);
   }
 
 
@@ -375,10 +407,38 @@ namespace ImmersedGrains
   }
 
 
+  template <int dim>
+  int
+  FluidSolver<dim>::coarse_correction_level() const
+  {
+    if (!parameters.coarse_correction)
+      return -1;
+    // Coarser than the mesh's coarsest cells (else the coarse space would
+    // be as large as the fine one), and small enough for a direct solve.
+    int coarsest = std::numeric_limits<int>::max();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        coarsest = std::min(coarsest, cell->level());
+    coarsest = -dealii::Utilities::MPI::max(-coarsest, mpi_communicator);
+    int level =
+      std::min<int>(parameters.coarse_correction_refinement, coarsest - 1);
+    std::size_t cells = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      cells *= geometry.subdivisions[d];
+    while (level >= 0 && (cells << (dim * level)) > (dim == 2 ? 4096u : 512u))
+      --level;
+    return level;
+  }
+
+
   template void
   FluidSolver<2>::build_preconditioner();
   template void
   FluidSolver<3>::build_preconditioner();
+  template int
+  FluidSolver<2>::coarse_correction_level() const;
+  template int
+  FluidSolver<3>::coarse_correction_level() const;
   template unsigned int
   FluidSolver<2>::solve_linear_system(double, bool);
   template unsigned int

@@ -17,6 +17,7 @@
 #include <immersed_grains/fluid/block_preconditioner.h>
 #include <immersed_grains/fluid/cell_gather.h>
 #include <immersed_grains/fluid/cell_scatter.h>
+#include <immersed_grains/fluid/coarse_schur_correction.h>
 #include <immersed_grains/fluid/fluid_solver.h>
 #include <immersed_grains/parameters.h>
 
@@ -343,6 +344,7 @@ namespace ImmersedGrains
     dealii::TimerOutput::Scope scope(timer, "fluid: setup");
     // The preconditioner refers to the matrices about to be rebuilt.
     preconditioner.reset();
+    coarse_schur.reset();
 
     dof_handler.distribute_dofs(fe);
     renumber_by_node_cuthill_mckee(dof_handler);

@@ -27,6 +27,8 @@ namespace ImmersedGrains
    * reduced where drag dominates (fluid_assembly.cc). doc/theory.md
    * motivates the choice.
    */
+  class CoarseSchurCorrection;
+
   class BlockSchurPreconditioner
   {
   public:
@@ -74,13 +76,21 @@ namespace ImmersedGrains
       const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
       const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass,
       const dealii::TrilinosWrappers::SparseMatrix      *pressure_laplace,
-      const Settings                                    &settings);
+      const Settings                                    &settings,
+      const CoarseSchurCorrection                       *coarse = nullptr);
+    // @p coarse, if given, is applied first (CoarseSchurCorrection).
 
     void
     vmult(VectorType &dst, const VectorType &src) const;
 
 
   private:
+    void
+    apply_block(VectorType &dst, const VectorType &src) const;
+
+    // The two-level correction's solution and the residual it leaves.
+    mutable VectorType coarse_correction, coarse_residual;
+
     void
     solve_velocity(dealii::TrilinosWrappers::MPI::Vector       &dst,
                    const dealii::TrilinosWrappers::MPI::Vector &src) const;
@@ -92,6 +102,7 @@ namespace ImmersedGrains
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
     const Settings                                     settings;
     const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass;
+    const CoarseSchurCorrection                       *coarse;
 
     // The one of these that A~^{-1} applies.
     const dealii::TrilinosWrappers::PreconditionBase &

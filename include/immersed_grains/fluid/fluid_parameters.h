@@ -78,13 +78,17 @@ namespace ImmersedGrains
     VelocityPreconditioner velocity_preconditioner =
       VelocityPreconditioner::automatic;
     // With `auto`, the ILU is chosen below this viscous number.
-    double       velocity_ilu_threshold       = 1;
-    unsigned int velocity_ilu_sweeps          = 1;
-    unsigned int velocity_amg_cycles          = 1; // auto: 2 if steady
-    unsigned int velocity_inner_iterations    = 0;
-    double       velocity_inner_tolerance     = 1e-6;
-    unsigned int pressure_mass_iterations     = 3;
-    double       pressure_mass_tolerance      = 3e-4;
+    double       velocity_ilu_threshold    = 1;
+    unsigned int velocity_ilu_sweeps       = 1;
+    unsigned int velocity_amg_cycles       = 1; // auto: 2 if steady
+    unsigned int velocity_inner_iterations = 0;
+    double       velocity_inner_tolerance  = 1e-6;
+    unsigned int pressure_mass_iterations  = 3;
+    double       pressure_mass_tolerance   = 3e-4;
+    // The two-level correction (coarse_schur_correction.h): whether, and
+    // how many times the box's coarse mesh is refined for its space.
+    bool         coarse_correction            = false;
+    unsigned int coarse_correction_refinement = 2;
     double       preconditioner_rebuild_ratio = 1.5; // 0: every solve
 
     // Prescribed fields; shared so that a test can substitute exact ones.

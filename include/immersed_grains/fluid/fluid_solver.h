@@ -26,6 +26,7 @@
 namespace ImmersedGrains
 {
   class BlockSchurPreconditioner;
+  class CoarseSchurCorrection;
   template <int dim>
   class CellScatter;
   template <int dim>
@@ -266,6 +267,11 @@ namespace ImmersedGrains
     void
     build_preconditioner();
 
+    // The refinement of the box's coarse mesh for the two-level correction,
+    // or -1 where it is off or the mesh is too coarse for it (collective).
+    int
+    coarse_correction_level() const;
+
     // Whether the velocity block couples different components: only
     // through Newton's derivative of the advection term (the slip faces of
     // a box are normal to an axis and fix one component each).
@@ -365,6 +371,7 @@ namespace ImmersedGrains
     std::unique_ptr<CellGather<dim>> cell_gather;
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
+    std::unique_ptr<CoarseSchurCorrection>    coarse_schur;
     // Whether any drag is present; without it and without inertia (steady
     // Stokes) the Laplacian term of the Schur approximation is left out,
     // except in elongated boxes (build_preconditioner()).

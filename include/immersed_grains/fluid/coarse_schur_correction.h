@@ -1,0 +1,121 @@
+#ifndef immersed_grains_fluid_coarse_schur_correction_h
+#define immersed_grains_fluid_coarse_schur_correction_h
+
+#include <deal.II/base/index_set.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/trilinos_block_sparse_matrix.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <map>
+#include <memory>
+#include <vector>
+
+namespace dealii
+{
+  template <int dim, int spacedim>
+  class DoFHandler;
+  template <typename number>
+  class AffineConstraints;
+} // namespace dealii
+
+namespace ImmersedGrains
+{
+  template <int dim>
+  class Geometry;
+
+  /**
+   * The second level of the fluid's preconditioner: the saddle point system
+   * on a coarse Taylor-Hood space. It carries the pressure modes that vary
+   * over many cells (Poiseuille flow along a long channel, flow around and
+   * through a region of drag), which the pressure mass matrix and the Darcy
+   * operator of BlockSchurPreconditioner approximate only within the
+   * domain's inf-sup constant.
+   *
+   * The coarse space is the Q2-Q1 space of the box's coarse mesh refined
+   * @p coarse_refinement times, interpolated at the fine DoFs' support
+   * points (P_u, P_p; rows of constrained fine DoFs left empty, so every
+   * coarse function is an admissible fine one), and restricted by weights
+   * to the fine velocities where viscosity dominates A (and the pressure
+   * nodes at their vertices): where mass or drag dominate, the velocity is
+   * local, and coarse functions reaching into such a region would carry its
+   * drag into the flow around it. The coarse operators are the Galerkin
+   * products of the assembled blocks, A_H = P_u^T W A W P_u and so on, so
+   * that drag, fluid fraction and viscosity enter as the fine matrix has
+   * them; the coarse system is factorised once per build (Amesos KLU, all
+   * coarse rows on rank 0). Applied, it gives Pi K_H^{-1} Pi^T r with
+   * Pi = diag(W P_u, W_p P_p).
+   */
+  class CoarseSchurCorrection
+  {
+  public:
+    /**
+     * The interpolation from the coarse space to the fine DoFs of
+     * @p dof_handler (velocity components first, then the pressure, as
+     * FluidSolver numbers them; @p owned_partitioning gives each block's
+     * owned DoFs, block-local).
+     */
+    template <int dim>
+    CoarseSchurCorrection(
+      const dealii::DoFHandler<dim, dim>      &dof_handler,
+      const dealii::AffineConstraints<double> &constraints,
+      const Geometry<dim>                     &geometry,
+      unsigned int                             coarse_refinement,
+      const std::vector<dealii::IndexSet>     &owned_partitioning,
+      MPI_Comm                                 mpi_communicator);
+
+    ~CoarseSchurCorrection();
+
+    /**
+     * The coarse operators of @p system_matrix, factorised, for the weights
+     * @p velocity_weight (1 where a fine velocity belongs to the coarse
+     * space, 0 where not). With @p pin_pressure (no open face: the pressure
+     * is fixed up to a constant) the first coarse pressure is held at zero.
+     */
+    void
+    build(const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
+          const dealii::TrilinosWrappers::MPI::Vector       &velocity_weight,
+          bool                                               pin_pressure);
+
+    /**
+     * dst = Pi K_H^{-1} Pi^T src: the coarse saddle point system's solution
+     * interpolated, Pi = diag(W P_u, W_p P_p).
+     */
+    void
+    vmult(dealii::TrilinosWrappers::MPI::BlockVector       &dst,
+          const dealii::TrilinosWrappers::MPI::BlockVector &src) const;
+
+  private:
+    MPI_Comm                               mpi_communicator;
+    dealii::types::global_dof_index        n_coarse_velocities = 0;
+    dealii::types::global_dof_index        n_coarse_pressure   = 0;
+    dealii::TrilinosWrappers::SparseMatrix velocity_interpolation;
+    dealii::TrilinosWrappers::SparseMatrix pressure_interpolation;
+    // Coarse DoFs that no unconstrained fine DoF sees: identity rows.
+    std::vector<bool> unused;
+    bool              pinned = false;
+    // Coarse DoFs the last build() left without an operator: identity rows.
+    std::vector<bool> empty;
+
+    dealii::TrilinosWrappers::SparseMatrix                  coarse_matrix;
+    dealii::SolverControl                                   solver_control;
+    std::unique_ptr<dealii::TrilinosWrappers::SolverDirect> coarse_solver;
+
+    mutable dealii::TrilinosWrappers::MPI::Vector coarse_pressure;
+    mutable dealii::TrilinosWrappers::MPI::Vector coarse_velocity;
+    mutable dealii::TrilinosWrappers::MPI::Vector coarse_rhs;
+    mutable dealii::TrilinosWrappers::MPI::Vector coarse_solution;
+    mutable dealii::TrilinosWrappers::MPI::Vector fine_pressure;
+    mutable dealii::TrilinosWrappers::MPI::Vector fine_velocity;
+    dealii::TrilinosWrappers::MPI::Vector         velocity_weight;
+    dealii::TrilinosWrappers::MPI::Vector         pressure_weight;
+    dealii::TrilinosWrappers::MPI::Vector         velocity_weight_ghosted;
+    // Each owned fine pressure's vertex: the velocity DoF there.
+    std::map<dealii::types::global_dof_index, dealii::types::global_dof_index>
+      pressure_vertex_velocity;
+  };
+} // namespace ImmersedGrains
+
+#endif

@@ -1,0 +1,400 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_renumbering.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_index_access.h>
+#include <deal.II/lac/trilinos_sparsity_pattern.h>
+
+#include <immersed_grains/fluid/coarse_schur_correction.h>
+#include <immersed_grains/mesh/geometry.h>
+
+#include <Epetra_CrsMatrix.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    // The coarse DoFs: all on rank 0, where the coarse system is factorised.
+    dealii::IndexSet
+    owned_by_root(const dealii::types::global_dof_index n, MPI_Comm comm)
+    {
+      dealii::IndexSet owned(n);
+      if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+        owned.add_range(0, n);
+      owned.compress();
+      return owned;
+    }
+
+    struct Entry
+    {
+      dealii::types::global_dof_index row, column;
+      double                          value;
+    };
+
+    // A matrix of the given rows (owned here) and columns from its entries.
+    void
+    fill(dealii::TrilinosWrappers::SparseMatrix &matrix,
+         const dealii::IndexSet                 &rows,
+         const dealii::IndexSet                 &columns,
+         const std::vector<Entry>               &entries,
+         MPI_Comm                                comm)
+    {
+      dealii::TrilinosWrappers::SparsityPattern pattern(rows, columns, comm);
+      for (const Entry &e : entries)
+        pattern.add(e.row, e.column);
+      pattern.compress();
+      matrix.reinit(pattern);
+      for (const Entry &e : entries)
+        matrix.add(e.row, e.column, e.value);
+      matrix.compress(dealii::VectorOperation::add);
+    }
+  } // namespace
+
+
+  template <int dim>
+  CoarseSchurCorrection::CoarseSchurCorrection(
+    const dealii::DoFHandler<dim, dim>      &dof_handler,
+    const dealii::AffineConstraints<double> &constraints,
+    const Geometry<dim>                     &geometry,
+    const unsigned int                       coarse_refinement,
+    const std::vector<dealii::IndexSet>     &owned_partitioning,
+    MPI_Comm                                 mpi_communicator)
+      : mpi_communicator(mpi_communicator)
+      , solver_control(1, 0)
+  {
+    const auto &fe = dof_handler.get_fe();
+
+    // The coarse mesh: the box's own, refined; numbered like the fine one
+    // (velocity components, then the pressure).
+    dealii::Triangulation<dim> coarse_mesh;
+    std::vector<unsigned int>  cells(dim);
+    dealii::Tensor<1, dim>     cell_size;
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      cells[d] = geometry.subdivisions[d] << coarse_refinement;
+      cell_size[d] =
+        (geometry.upper_corner[d] - geometry.lower_corner[d]) / cells[d];
+    }
+    dealii::GridGenerator::subdivided_hyper_rectangle(coarse_mesh,
+                                                      cells,
+                                                      geometry.lower_corner,
+                                                      geometry.upper_corner);
+    dealii::DoFHandler<dim> coarse_dofs(coarse_mesh);
+    coarse_dofs.distribute_dofs(fe);
+    std::vector<unsigned int> block_component(dim + 1, 0);
+    block_component[dim] = 1;
+    dealii::DoFRenumbering::component_wise(coarse_dofs, block_component);
+    const auto coarse_per_block =
+      dealii::DoFTools::count_dofs_per_fe_block(coarse_dofs, block_component);
+    n_coarse_velocities = coarse_per_block[0];
+    n_coarse_pressure   = coarse_per_block[1];
+
+    // Coarse cells by their position in the box.
+    const auto index_of = [&](const dealii::Point<dim> &x)
+    {
+      unsigned int index = 0, stride = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const int i = static_cast<int>(
+          std::floor((x[d] - geometry.lower_corner[d]) / cell_size[d]));
+        index += stride * std::clamp(i, 0, static_cast<int>(cells[d]) - 1);
+        stride *= cells[d];
+      }
+      return index;
+    };
+    std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator>
+      coarse_cell(coarse_mesh.n_active_cells());
+    for (const auto &cell : coarse_dofs.active_cell_iterators())
+      coarse_cell[index_of(cell->center())] = cell;
+
+    const dealii::IndexSet coarse_velocity_owned =
+      owned_by_root(n_coarse_velocities, mpi_communicator);
+    const dealii::IndexSet coarse_pressure_owned =
+      owned_by_root(n_coarse_pressure, mpi_communicator);
+    const unsigned int per_cell = fe.n_dofs_per_cell();
+    std::vector<Entry> velocity_entries, pressure_entries;
+
+    // Each owned, unconstrained fine DoF once: the coarse shape functions
+    // of its component at its support point.
+    const dealii::types::global_dof_index n_u = owned_partitioning[0].size();
+    const dealii::IndexSet    owned = dof_handler.locally_owned_dofs();
+    std::vector<bool>         done(owned.n_elements(), false);
+    std::vector<unsigned int> seen(n_coarse_velocities + n_coarse_pressure, 0);
+    const auto               &unit_points = fe.get_unit_support_points();
+    std::vector<dealii::types::global_dof_index> fine_indices(per_cell),
+      coarse_indices(per_cell);
+    std::map<std::array<long long, dim + 1>,
+             std::vector<std::pair<unsigned int, double>>>
+      shape_values;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+    {
+      if (!cell->is_locally_owned())
+        continue;
+      cell->get_dof_indices(fine_indices);
+      for (const unsigned int v : cell->vertex_indices())
+      {
+        const auto p = cell->vertex_dof_index(v, dim);
+        if (owned.is_element(p))
+          pressure_vertex_velocity[p - n_u] = cell->vertex_dof_index(v, 0);
+      }
+      const dealii::Point<dim> corner = cell->vertex(0);
+      const dealii::Point<dim> far    = cell->vertex((1 << dim) - 1);
+      for (unsigned int k = 0; k < per_cell; ++k)
+      {
+        const auto g = fine_indices[k];
+        if (!owned.is_element(g) || constraints.is_constrained(g))
+          continue;
+        const auto local = owned.index_within_set(g);
+        if (done[local])
+          continue;
+        done[local] = true;
+
+        dealii::Point<dim> x;
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d] = corner[d] + unit_points[k][d] * (far[d] - corner[d]);
+        const auto &coarse = coarse_cell[index_of(x)];
+        coarse->get_dof_indices(coarse_indices);
+        const dealii::Point<dim> coarse_corner = coarse->vertex(0);
+        dealii::Point<dim>       xi;
+        for (unsigned int d = 0; d < dim; ++d)
+          xi[d] = (x[d] - coarse_corner[d]) / cell_size[d];
+
+        // The same few points recur on every coarse cell: their values are
+        // computed once.
+        const unsigned int component = fe.system_to_component_index(k).first;
+        std::array<long long, dim + 1> key;
+        for (unsigned int d = 0; d < dim; ++d)
+          key[d] = std::llround(xi[d] * (1 << 20));
+        key[dim]   = component;
+        auto known = shape_values.find(key);
+        if (known == shape_values.end())
+        {
+          std::vector<std::pair<unsigned int, double>> values;
+          for (unsigned int j = 0; j < per_cell; ++j)
+            if (fe.system_to_component_index(j).first == component)
+            {
+              const double value = fe.shape_value(j, xi);
+              if (std::abs(value) > 1e-12)
+                values.emplace_back(j, value);
+            }
+          known = shape_values.emplace(key, std::move(values)).first;
+        }
+        for (const auto &[j, value] : known->second)
+        {
+          const auto J = coarse_indices[j];
+          seen[J]      = 1;
+          if (component < dim)
+            velocity_entries.push_back({g, J, value});
+          else
+            pressure_entries.push_back(
+              {g - n_u, J - n_coarse_velocities, value});
+        }
+      }
+    }
+    fill(velocity_interpolation,
+         owned_partitioning[0],
+         coarse_velocity_owned,
+         velocity_entries,
+         mpi_communicator);
+    fill(pressure_interpolation,
+         owned_partitioning[1],
+         coarse_pressure_owned,
+         pressure_entries,
+         mpi_communicator);
+    dealii::Utilities::MPI::max(seen, mpi_communicator, seen);
+    unused.resize(seen.size());
+    for (unsigned int i = 0; i < seen.size(); ++i)
+      unused[i] = (seen[i] == 0);
+
+    coarse_pressure.reinit(coarse_pressure_owned, mpi_communicator);
+    coarse_velocity.reinit(coarse_velocity_owned, mpi_communicator);
+    const dealii::IndexSet coarse_owned =
+      owned_by_root(n_coarse_velocities + n_coarse_pressure, mpi_communicator);
+    coarse_rhs.reinit(coarse_owned, mpi_communicator);
+    coarse_solution.reinit(coarse_owned, mpi_communicator);
+    fine_pressure.reinit(owned_partitioning[1], mpi_communicator);
+    fine_velocity.reinit(owned_partitioning[0], mpi_communicator);
+    dealii::IndexSet needed(n_u);
+    for (const auto &pair : pressure_vertex_velocity)
+      needed.add_index(pair.second);
+    needed.add_indices(owned_partitioning[0]);
+    needed.compress();
+    velocity_weight_ghosted.reinit(owned_partitioning[0],
+                                   needed,
+                                   mpi_communicator);
+    pressure_weight.reinit(owned_partitioning[1], mpi_communicator);
+  }
+
+
+  CoarseSchurCorrection::~CoarseSchurCorrection() = default;
+
+
+  void
+  CoarseSchurCorrection::build(
+    const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
+    const dealii::TrilinosWrappers::MPI::Vector       &velocity_weight,
+    const bool                                         pin_pressure)
+  {
+    pinned                = pin_pressure;
+    this->velocity_weight = velocity_weight;
+    // A pressure node counts where the velocity at its vertex does.
+    velocity_weight_ghosted = velocity_weight;
+    for (const auto &pair : pressure_vertex_velocity)
+      pressure_weight[pair.first] = velocity_weight_ghosted[pair.second];
+    pressure_weight.compress(dealii::VectorOperation::insert);
+    // The Galerkin products, block by block.
+    const dealii::TrilinosWrappers::SparseMatrix *interpolation[2] = {
+      &velocity_interpolation, &pressure_interpolation};
+    const dealii::types::global_dof_index offset[2] = {0, n_coarse_velocities};
+    const dealii::IndexSet                coarse_owned =
+      owned_by_root(n_coarse_velocities + n_coarse_pressure, mpi_communicator);
+    std::vector<Entry> entries;
+    for (unsigned int bi = 0; bi < 2; ++bi)
+      for (unsigned int bj = 0; bj < 2; ++bj)
+      {
+        dealii::TrilinosWrappers::SparseMatrix       product, coarse_block;
+        const dealii::TrilinosWrappers::MPI::Vector *weight[2] = {
+          &velocity_weight, &pressure_weight};
+        system_matrix.block(bi, bj).mmult(product,
+                                          *interpolation[bj],
+                                          *weight[bj]);
+        interpolation[bi]->Tmmult(coarse_block, product, *weight[bi]);
+        const Epetra_CrsMatrix &m = coarse_block.trilinos_matrix();
+        for (int row = 0; row < m.NumMyRows(); ++row)
+        {
+          int     n       = 0;
+          double *values  = nullptr;
+          int    *indices = nullptr;
+          m.ExtractMyRowView(row, n, values, indices);
+          const auto global_row =
+            dealii::TrilinosWrappers::global_row_index(m, row) + offset[bi];
+          if (unused[global_row] ||
+              (pin_pressure && global_row == n_coarse_velocities))
+            continue;
+          for (int k = 0; k < n; ++k)
+            entries.push_back(
+              {global_row,
+               dealii::TrilinosWrappers::global_column_index(m, indices[k]) +
+                 offset[bj],
+               values[k]});
+        }
+      }
+    // Coarse velocities whose functions the weight removed (no diagonal),
+    // then pressures left without a velocity or a diagonal of their own.
+    empty.assign(n_coarse_velocities + n_coarse_pressure, false);
+    for (const auto i : coarse_owned)
+      empty[i] = true;
+    for (const Entry &e : entries)
+      if (e.value != 0 && e.row == e.column && e.row < n_coarse_velocities)
+        empty[e.row] = false;
+    for (const Entry &e : entries)
+      if (e.value != 0 && e.row >= n_coarse_velocities &&
+          (e.row == e.column ||
+           (e.column < n_coarse_velocities && !empty[e.column])))
+        empty[e.row] = false;
+    // Where the weights leave more coarse pressures in a region than its
+    // velocities can tell apart, S_H is singular: a shift of 10^-8 of a
+    // local estimate of its diagonal, sum_j B_ij^2 / A_jj, on the pressure
+    // block makes the system regular without touching the modes it does
+    // resolve.
+    std::vector<double> velocity_diagonal(n_coarse_velocities, 0.0),
+      schur_diagonal(n_coarse_pressure, 0.0);
+    for (const Entry &e : entries)
+      if (e.row == e.column && e.row < n_coarse_velocities)
+        velocity_diagonal[e.row] = e.value;
+    // The weights can leave two coarse velocity functions the same fine
+    // function (where they keep a single fine node of both): A_H is then
+    // singular in a combination whose fine image is zero. A relative shift
+    // of its diagonal makes it regular without changing any fine value.
+    for (unsigned int i = 0; i < n_coarse_velocities; ++i)
+      if (velocity_diagonal[i] > 0)
+        entries.push_back({i, i, 1e-6 * velocity_diagonal[i]});
+    for (const Entry &e : entries)
+      if (e.row >= n_coarse_velocities && e.column < n_coarse_velocities &&
+          velocity_diagonal[e.column] > 0)
+        schur_diagonal[e.row - n_coarse_velocities] +=
+          e.value * e.value / velocity_diagonal[e.column];
+    for (unsigned int i = 0; i < n_coarse_pressure; ++i)
+      if (schur_diagonal[i] > 0)
+        entries.push_back({n_coarse_velocities + i,
+                           n_coarse_velocities + i,
+                           -1e-8 * schur_diagonal[i]});
+    entries.erase(std::remove_if(entries.begin(),
+                                 entries.end(),
+                                 [&](const Entry &e)
+                                 { return empty[e.row] || empty[e.column]; }),
+                  entries.end());
+    // Identity rows where a coarse DoF has no fine counterpart, and for the
+    // pinned pressure.
+    for (const auto i : coarse_owned)
+      if (empty[i] || unused[i] || (pin_pressure && i == n_coarse_velocities))
+        entries.push_back({i, i, 1.0});
+    fill(coarse_matrix, coarse_owned, coarse_owned, entries, mpi_communicator);
+
+    coarse_solver = std::make_unique<dealii::TrilinosWrappers::SolverDirect>(
+      solver_control,
+      dealii::TrilinosWrappers::SolverDirect::AdditionalData(false,
+                                                             "Amesos_Klu"));
+    coarse_solver->initialize(coarse_matrix);
+  }
+
+
+  void
+  CoarseSchurCorrection::vmult(
+    dealii::TrilinosWrappers::MPI::BlockVector       &dst,
+    const dealii::TrilinosWrappers::MPI::BlockVector &src) const
+  {
+    fine_velocity = src.block(0);
+    fine_velocity.scale(velocity_weight);
+    velocity_interpolation.Tvmult(coarse_velocity, fine_velocity);
+    fine_pressure = src.block(1);
+    fine_pressure.scale(pressure_weight);
+    pressure_interpolation.Tvmult(coarse_pressure, fine_pressure);
+    for (const auto i : coarse_velocity.locally_owned_elements())
+      coarse_rhs[i] = unused[i] || empty[i] ? 0.0 : coarse_velocity[i];
+    for (const auto i : coarse_pressure.locally_owned_elements())
+      coarse_rhs[n_coarse_velocities + i] =
+        unused[n_coarse_velocities + i] || empty[n_coarse_velocities + i] ||
+            (pinned && i == 0) ?
+          0.0 :
+          coarse_pressure[i];
+    coarse_rhs.compress(dealii::VectorOperation::insert);
+    coarse_solver->solve(coarse_solution, coarse_rhs);
+    for (const auto i : coarse_velocity.locally_owned_elements())
+      coarse_velocity[i] = coarse_solution[i];
+    for (const auto i : coarse_pressure.locally_owned_elements())
+      coarse_pressure[i] = coarse_solution[n_coarse_velocities + i];
+    coarse_velocity.compress(dealii::VectorOperation::insert);
+    coarse_pressure.compress(dealii::VectorOperation::insert);
+    velocity_interpolation.vmult(dst.block(0), coarse_velocity);
+    dst.block(0).scale(velocity_weight);
+    pressure_interpolation.vmult(dst.block(1), coarse_pressure);
+    dst.block(1).scale(pressure_weight);
+  }
+
+
+
+  template CoarseSchurCorrection::CoarseSchurCorrection(
+    const dealii::DoFHandler<2, 2> &,
+    const dealii::AffineConstraints<double> &,
+    const Geometry<2> &,
+    unsigned int,
+    const std::vector<dealii::IndexSet> &,
+    MPI_Comm);
+  template CoarseSchurCorrection::CoarseSchurCorrection(
+    const dealii::DoFHandler<3, 3> &,
+    const dealii::AffineConstraints<double> &,
+    const Geometry<3> &,
+    unsigned int,
+    const std::vector<dealii::IndexSet> &,
+    MPI_Comm);
+} // namespace ImmersedGrains
