@@ -138,6 +138,7 @@ namespace ImmersedGrains
     if (coarse_level >= 0)
     {
       if (!coarse_schur)
+      {
         coarse_schur =
           std::make_unique<CoarseSchurCorrection>(dof_handler,
                                                   update_constraints,
@@ -145,6 +146,11 @@ namespace ImmersedGrains
                                                   coarse_level,
                                                   owned_partitioning,
                                                   mpi_communicator);
+        pcout << "  fluid: two-level preconditioner, the box's coarse mesh "
+                 "refined "
+              << coarse_level << " times (" << coarse_schur->n_dofs()
+              << " coarse DoFs)" << std::endl;
+      }
       // The coarse space spans the velocities where the viscous part of
       // A's diagonal exceeds the mass and drag part (with its floor, at
       // most 0.3 of the viscous part): where mass or drag dominate, the

@@ -252,8 +252,8 @@ namespace ImmersedGrains
           "iterations (doc/performance.md).");
         prm.declare_entry(
           "Coarse correction",
-          "false",
-          Bool(),
+          "auto",
+          Selection("auto|true|false"),
           "A second level for the block preconditioner: the Stokes problem "
           "on a coarse Taylor-Hood space (the box's coarse mesh refined "
           "Coarse correction refinement times), its operators the Galerkin "
@@ -263,8 +263,10 @@ namespace ImmersedGrains
           "the Schur complement approximation misses: steady flow in a 2D "
           "column 1 x 8 with a region of drag takes 13-22 instead of 25-40 "
           "FGMRES iterations at a tolerance of 1e-8, in about the same "
-          "time. Its set-up costs more than it saves in 3D and with a time "
-          "derivative (doc/adaptivity.md).");
+          "time. auto: on for steady flow (Time derivative = false) in 2D "
+          "boxes at least twice as long as their shortest side; in 3D and "
+          "with a time derivative its set-up costs more than it saves "
+          "(doc/adaptivity.md).");
         prm.declare_entry(
           "Coarse correction refinement",
           "2",
@@ -365,7 +367,11 @@ namespace ImmersedGrains
         pressure_mass_tolerance  = prm.get_double("Pressure mass tolerance");
         preconditioner_rebuild_ratio =
           prm.get_double("Preconditioner rebuild ratio");
-        coarse_correction = prm.get_bool("Coarse correction");
+        const std::string coarse = prm.get("Coarse correction");
+        coarse_correction =
+          coarse == "true" ||
+          (coarse == "auto" && dim == 2 && !time_derivative &&
+           geometry.longest_side() >= 2 * geometry.shortest_side());
         coarse_correction_refinement =
           prm.get_integer("Coarse correction refinement");
         where.require(velocity_inner_tolerance < 1,

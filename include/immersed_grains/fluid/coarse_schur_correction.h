@@ -87,6 +87,13 @@ namespace ImmersedGrains
     vmult(dealii::TrilinosWrappers::MPI::BlockVector       &dst,
           const dealii::TrilinosWrappers::MPI::BlockVector &src) const;
 
+    /** Velocity and pressure DoFs of the coarse space. */
+    dealii::types::global_dof_index
+    n_dofs() const
+    {
+      return n_coarse_velocities + n_coarse_pressure;
+    }
+
   private:
     MPI_Comm                               mpi_communicator;
     dealii::types::global_dof_index        n_coarse_velocities = 0;

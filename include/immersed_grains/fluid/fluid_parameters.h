@@ -85,8 +85,9 @@ namespace ImmersedGrains
     double       velocity_inner_tolerance  = 1e-6;
     unsigned int pressure_mass_iterations  = 3;
     double       pressure_mass_tolerance   = 3e-4;
-    // The two-level correction (coarse_schur_correction.h): whether, and
-    // how many times the box's coarse mesh is refined for its space.
+    // The two-level correction (coarse_schur_correction.h): whether (auto
+    // resolved), and how many times the box's coarse mesh is refined for
+    // its space.
     bool         coarse_correction            = false;
     unsigned int coarse_correction_refinement = 2;
     double       preconditioner_rebuild_ratio = 1.5; // 0: every solve

@@ -371,7 +371,8 @@ namespace ImmersedGrains
     std::unique_ptr<CellGather<dim>> cell_gather;
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
-    std::unique_ptr<CoarseSchurCorrection>    coarse_schur;
+    // Its second level (Linear solver/Coarse correction), once per mesh.
+    std::unique_ptr<CoarseSchurCorrection> coarse_schur;
     // Whether any drag is present; without it and without inertia (steady
     // Stokes) the Laplacian term of the Schur approximation is left out,
     // except in elongated boxes (build_preconditioner()).
