@@ -84,7 +84,7 @@ public:
     const std::string geometry = bench_geometry();
     if (geometry == "bed_column")
       return std::abs(x[1] - 6) < 0.5;
-    Point<dim>        c;
+    Point<dim> c;
     for (unsigned int d = 0; d < dim; ++d)
       c[d] = 0.5;
     if (geometry.find("column") != std::string::npos)

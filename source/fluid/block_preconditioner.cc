@@ -7,9 +7,7 @@
 #include <Epetra_MultiVector.h>
 #include <Teuchos_ParameterList.hpp>
 
-#include <cstdlib>
 #include <memory>
-#include <string>
 
 namespace ImmersedGrains
 {

@@ -96,7 +96,7 @@ namespace ImmersedGrains
     const auto coarse_per_block =
       dealii::DoFTools::count_dofs_per_fe_block(coarse_dofs, block_component);
     n_coarse_velocities = coarse_per_block[0];
-    n_coarse_pressure   = coarse_per_block[1];
+    n_coarse_pressures  = coarse_per_block[1];
 
     // Coarse cells by their position in the box.
     const auto index_of = [&](const dealii::Point<dim> &x)
@@ -119,17 +119,16 @@ namespace ImmersedGrains
     const dealii::IndexSet coarse_velocity_owned =
       owned_by_root(n_coarse_velocities, mpi_communicator);
     const dealii::IndexSet coarse_pressure_owned =
-      owned_by_root(n_coarse_pressure, mpi_communicator);
+      owned_by_root(n_coarse_pressures, mpi_communicator);
     const unsigned int per_cell = fe.n_dofs_per_cell();
     std::vector<Entry> velocity_entries, pressure_entries;
 
     // Each owned, unconstrained fine DoF once: the coarse shape functions
     // of its component at its support point.
     const dealii::types::global_dof_index n_u = owned_partitioning[0].size();
-    const dealii::IndexSet    owned = dof_handler.locally_owned_dofs();
-    std::vector<bool>         done(owned.n_elements(), false);
-    std::vector<unsigned int> seen(n_coarse_velocities + n_coarse_pressure, 0);
-    const auto               &unit_points = fe.get_unit_support_points();
+    const dealii::IndexSet owned = dof_handler.locally_owned_dofs();
+    std::vector<bool>      done(owned.n_elements(), false);
+    const auto            &unit_points = fe.get_unit_support_points();
     std::vector<dealii::types::global_dof_index> fine_indices(per_cell),
       coarse_indices(per_cell);
     std::map<std::array<long long, dim + 1>,
@@ -191,7 +190,6 @@ namespace ImmersedGrains
         for (const auto &[j, value] : known->second)
         {
           const auto J = coarse_indices[j];
-          seen[J]      = 1;
           if (component < dim)
             velocity_entries.push_back({g, J, value});
           else
@@ -210,15 +208,11 @@ namespace ImmersedGrains
          coarse_pressure_owned,
          pressure_entries,
          mpi_communicator);
-    dealii::Utilities::MPI::max(seen, mpi_communicator, seen);
-    unused.resize(seen.size());
-    for (unsigned int i = 0; i < seen.size(); ++i)
-      unused[i] = (seen[i] == 0);
 
     coarse_pressure.reinit(coarse_pressure_owned, mpi_communicator);
     coarse_velocity.reinit(coarse_velocity_owned, mpi_communicator);
     const dealii::IndexSet coarse_owned =
-      owned_by_root(n_coarse_velocities + n_coarse_pressure, mpi_communicator);
+      owned_by_root(n_coarse_velocities + n_coarse_pressures, mpi_communicator);
     coarse_rhs.reinit(coarse_owned, mpi_communicator);
     coarse_solution.reinit(coarse_owned, mpi_communicator);
     fine_pressure.reinit(owned_partitioning[1], mpi_communicator);
@@ -256,7 +250,7 @@ namespace ImmersedGrains
       &velocity_interpolation, &pressure_interpolation};
     const dealii::types::global_dof_index offset[2] = {0, n_coarse_velocities};
     const dealii::IndexSet                coarse_owned =
-      owned_by_root(n_coarse_velocities + n_coarse_pressure, mpi_communicator);
+      owned_by_root(n_coarse_velocities + n_coarse_pressures, mpi_communicator);
     std::vector<Entry> entries;
     for (unsigned int bi = 0; bi < 2; ++bi)
       for (unsigned int bj = 0; bj < 2; ++bj)
@@ -277,8 +271,7 @@ namespace ImmersedGrains
           m.ExtractMyRowView(row, n, values, indices);
           const auto global_row =
             dealii::TrilinosWrappers::global_row_index(m, row) + offset[bi];
-          if (unused[global_row] ||
-              (pin_pressure && global_row == n_coarse_velocities))
+          if (pin_pressure && global_row == n_coarse_velocities)
             continue;
           for (int k = 0; k < n; ++k)
             entries.push_back(
@@ -288,9 +281,10 @@ namespace ImmersedGrains
                values[k]});
         }
       }
-    // Coarse velocities whose functions the weight removed (no diagonal),
-    // then pressures left without a velocity or a diagonal of their own.
-    empty.assign(n_coarse_velocities + n_coarse_pressure, false);
+    // Coarse velocities without a function (no fine DoF sees them, or the
+    // weight removed them: no diagonal), then pressures left without a
+    // velocity or a diagonal of their own.
+    empty.assign(n_coarse_velocities + n_coarse_pressures, false);
     for (const auto i : coarse_owned)
       empty[i] = true;
     for (const Entry &e : entries)
@@ -307,7 +301,7 @@ namespace ImmersedGrains
     // block makes the system regular without touching the modes it does
     // resolve.
     std::vector<double> velocity_diagonal(n_coarse_velocities, 0.0),
-      schur_diagonal(n_coarse_pressure, 0.0);
+      schur_diagonal(n_coarse_pressures, 0.0);
     for (const Entry &e : entries)
       if (e.row == e.column && e.row < n_coarse_velocities)
         velocity_diagonal[e.row] = e.value;
@@ -323,7 +317,7 @@ namespace ImmersedGrains
           velocity_diagonal[e.column] > 0)
         schur_diagonal[e.row - n_coarse_velocities] +=
           e.value * e.value / velocity_diagonal[e.column];
-    for (unsigned int i = 0; i < n_coarse_pressure; ++i)
+    for (unsigned int i = 0; i < n_coarse_pressures; ++i)
       if (schur_diagonal[i] > 0)
         entries.push_back({n_coarse_velocities + i,
                            n_coarse_velocities + i,
@@ -333,10 +327,10 @@ namespace ImmersedGrains
                                  [&](const Entry &e)
                                  { return empty[e.row] || empty[e.column]; }),
                   entries.end());
-    // Identity rows where a coarse DoF has no fine counterpart, and for the
-    // pinned pressure.
+    // Identity rows where a coarse DoF has no operator, and for the pinned
+    // pressure.
     for (const auto i : coarse_owned)
-      if (empty[i] || unused[i] || (pin_pressure && i == n_coarse_velocities))
+      if (empty[i] || (pin_pressure && i == n_coarse_velocities))
         entries.push_back({i, i, 1.0});
     fill(coarse_matrix, coarse_owned, coarse_owned, entries, mpi_communicator);
 
@@ -360,11 +354,10 @@ namespace ImmersedGrains
     fine_pressure.scale(pressure_weight);
     pressure_interpolation.Tvmult(coarse_pressure, fine_pressure);
     for (const auto i : coarse_velocity.locally_owned_elements())
-      coarse_rhs[i] = unused[i] || empty[i] ? 0.0 : coarse_velocity[i];
+      coarse_rhs[i] = empty[i] ? 0.0 : coarse_velocity[i];
     for (const auto i : coarse_pressure.locally_owned_elements())
       coarse_rhs[n_coarse_velocities + i] =
-        unused[n_coarse_velocities + i] || empty[n_coarse_velocities + i] ||
-            (pinned && i == 0) ?
+        empty[n_coarse_velocities + i] || (pinned && i == 0) ?
           0.0 :
           coarse_pressure[i];
     coarse_rhs.compress(dealii::VectorOperation::insert);
@@ -380,7 +373,6 @@ namespace ImmersedGrains
     pressure_interpolation.vmult(dst.block(1), coarse_pressure);
     dst.block(1).scale(pressure_weight);
   }
-
 
 
   template CoarseSchurCorrection::CoarseSchurCorrection(

@@ -124,20 +124,12 @@ namespace ImmersedGrains
       settings.velocity_constant_modes = {any_component};
     }
 
-    // Steady flow without drag in a box at least twice as long as wide:
-    // the pressure modes that vary slowly along it are those of Poiseuille
-    // flow between its walls, a Darcy law of permeability ~ W^2 that the
-    // mass term misses (its inf-sup constant falls like the inverse aspect
-    // ratio). The floor's Darcy term, at a quarter of its coefficient,
-    // catches them: a 1 x 8 column 38-46 -> 27-32 outer iterations, a
-    // 1 x 1/8 slab 22-33 -> 16-31 (2D and 3D, levels 1-5; doc/adaptivity.md).
-    // In a cube it only adds error (2D level 6: 21 -> 30), hence the gate.
     // The two-level correction: its coarse space once per mesh, its
     // operators with every preconditioner.
-    const int coarse_level = coarse_correction_level();
-    if (coarse_level >= 0)
+    if (parameters.coarse_correction && !coarse_schur)
     {
-      if (!coarse_schur)
+      const int coarse_level = coarse_correction_level();
+      if (coarse_level >= 0)
       {
         coarse_schur =
           std::make_unique<CoarseSchurCorrection>(dof_handler,
@@ -151,6 +143,9 @@ namespace ImmersedGrains
               << coarse_level << " times (" << coarse_schur->n_dofs()
               << " coarse DoFs)" << std::endl;
       }
+    }
+    if (coarse_schur)
+    {
       // The coarse space spans the velocities where the viscous part of
       // A's diagonal exceeds the mass and drag part (with its floor, at
       // most 0.3 of the viscous part): where mass or drag dominate, the
@@ -167,6 +162,14 @@ namespace ImmersedGrains
       weight.compress(dealii::VectorOperation::insert);
       coarse_schur->build(system_matrix, weight, pressure_has_null_space());
     }
+    // Steady flow without drag in a box at least twice as long as wide:
+    // the pressure modes that vary slowly along it are those of Poiseuille
+    // flow between its walls, a Darcy law of permeability ~ W^2 that the
+    // mass term misses (its inf-sup constant falls like the inverse aspect
+    // ratio). The floor's Darcy term, at a quarter of its coefficient,
+    // catches them: a 1 x 8 column 38-46 -> 27-32 outer iterations, a
+    // 1 x 1/8 slab 22-33 -> 16-31 (2D and 3D, levels 1-5; doc/adaptivity.md).
+    // In a cube it only adds error (2D level 6: 21 -> 30), hence the gate.
     const bool long_modes =
       !parameters.time_derivative && !schur_has_drag &&
       geometry.longest_side() >= 2 * geometry.shortest_side();
@@ -277,7 +280,7 @@ namespace ImmersedGrains
                                      nullptr,
       laplace_term ? &schur_diagonal_matrix : nullptr,
       settings,
-      coarse_level >= 0 ? coarse_schur.get() : nullptr);
+      coarse_schur.get());
   }
 
 
@@ -417,8 +420,6 @@ namespace ImmersedGrains
   int
   FluidSolver<dim>::coarse_correction_level() const
   {
-    if (!parameters.coarse_correction)
-      return -1;
     // Coarser than the mesh's coarsest cells (else the coarse space would
     // be as large as the fine one), and small enough for a direct solve.
     int coarsest = std::numeric_limits<int>::max();

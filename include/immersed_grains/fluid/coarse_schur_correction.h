@@ -91,19 +91,18 @@ namespace ImmersedGrains
     dealii::types::global_dof_index
     n_dofs() const
     {
-      return n_coarse_velocities + n_coarse_pressure;
+      return n_coarse_velocities + n_coarse_pressures;
     }
 
   private:
     MPI_Comm                               mpi_communicator;
     dealii::types::global_dof_index        n_coarse_velocities = 0;
-    dealii::types::global_dof_index        n_coarse_pressure   = 0;
+    dealii::types::global_dof_index        n_coarse_pressures  = 0;
     dealii::TrilinosWrappers::SparseMatrix velocity_interpolation;
     dealii::TrilinosWrappers::SparseMatrix pressure_interpolation;
-    // Coarse DoFs that no unconstrained fine DoF sees: identity rows.
-    std::vector<bool> unused;
-    bool              pinned = false;
-    // Coarse DoFs the last build() left without an operator: identity rows.
+    bool                                   pinned = false;
+    // Coarse DoFs the last build() left without an operator (no fine DoF
+    // sees them, or the weights removed them): identity rows.
     std::vector<bool> empty;
 
     dealii::TrilinosWrappers::SparseMatrix                  coarse_matrix;

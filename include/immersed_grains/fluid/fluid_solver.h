@@ -268,7 +268,7 @@ namespace ImmersedGrains
     build_preconditioner();
 
     // The refinement of the box's coarse mesh for the two-level correction,
-    // or -1 where it is off or the mesh is too coarse for it (collective).
+    // or -1 where the mesh is too coarse for it (collective).
     int
     coarse_correction_level() const;
 
