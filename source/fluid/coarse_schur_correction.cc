@@ -12,6 +12,7 @@
 #include <immersed_grains/fluid/coarse_schur_correction.h>
 #include <immersed_grains/mesh/geometry.h>
 
+#include <EpetraExt_MatrixMatrix.h>
 #include <Epetra_CrsMatrix.h>
 
 #include <algorithm>
@@ -56,6 +57,48 @@ namespace ImmersedGrains
       for (const Entry &e : entries)
         matrix.add(e.row, e.column, e.value);
       matrix.compress(dealii::VectorOperation::add);
+    }
+
+    // The rows of @p interpolation where @p weight is not zero: the
+    // weighted interpolation diag(W) P without its empty rows, so that the
+    // products with it cost only where it has entries. @p interpolation
+    // itself where the weight keeps every row.
+    const dealii::TrilinosWrappers::SparseMatrix *
+    restrict_rows(dealii::TrilinosWrappers::SparseMatrix       &restricted,
+                  const dealii::TrilinosWrappers::SparseMatrix &interpolation,
+                  const dealii::TrilinosWrappers::MPI::Vector  &weight,
+                  MPI_Comm                                      comm)
+    {
+      bool every_row = true;
+      for (const auto i : weight.locally_owned_elements())
+        every_row = every_row && weight[i] != 0;
+      if (!dealii::Utilities::MPI::logical_or(!every_row, comm))
+        return &interpolation;
+      std::vector<Entry>      entries;
+      const Epetra_CrsMatrix &m = interpolation.trilinos_matrix();
+      for (int row = 0; row < m.NumMyRows(); ++row)
+      {
+        const dealii::types::global_dof_index global_row =
+          dealii::TrilinosWrappers::global_row_index(m, row);
+        if (weight[global_row] == 0)
+          continue;
+        int     n       = 0;
+        double *values  = nullptr;
+        int    *indices = nullptr;
+        m.ExtractMyRowView(row, n, values, indices);
+        for (int k = 0; k < n; ++k)
+          entries.push_back(
+            {global_row,
+             static_cast<dealii::types::global_dof_index>(
+               dealii::TrilinosWrappers::global_column_index(m, indices[k])),
+             values[k]});
+      }
+      fill(restricted,
+           interpolation.locally_owned_range_indices(),
+           interpolation.locally_owned_domain_indices(),
+           entries,
+           comm);
+      return &restricted;
     }
   } // namespace
 
@@ -215,16 +258,15 @@ namespace ImmersedGrains
       owned_by_root(n_coarse_velocities + n_coarse_pressures, mpi_communicator);
     coarse_rhs.reinit(coarse_owned, mpi_communicator);
     coarse_solution.reinit(coarse_owned, mpi_communicator);
-    fine_pressure.reinit(owned_partitioning[1], mpi_communicator);
     fine_velocity.reinit(owned_partitioning[0], mpi_communicator);
     dealii::IndexSet needed(n_u);
     for (const auto &pair : pressure_vertex_velocity)
       needed.add_index(pair.second);
     needed.add_indices(owned_partitioning[0]);
     needed.compress();
-    velocity_weight_ghosted.reinit(owned_partitioning[0],
-                                   needed,
-                                   mpi_communicator);
+    drag_share_ghosted.reinit(owned_partitioning[0], needed, mpi_communicator);
+    viscous_weight.reinit(owned_partitioning[0], mpi_communicator);
+    drag_weight.reinit(owned_partitioning[0], mpi_communicator);
     pressure_weight.reinit(owned_partitioning[1], mpi_communicator);
   }
 
@@ -235,34 +277,87 @@ namespace ImmersedGrains
   void
   CoarseSchurCorrection::build(
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
-    const dealii::TrilinosWrappers::MPI::Vector       &velocity_weight,
+    const dealii::TrilinosWrappers::MPI::Vector       &drag_share,
     const bool                                         pin_pressure)
   {
-    pinned                = pin_pressure;
-    this->velocity_weight = velocity_weight;
-    // A pressure node counts where the velocity at its vertex does.
-    velocity_weight_ghosted = velocity_weight;
+    pinned = pin_pressure;
+    // A fine velocity belongs to the viscous part where mass and drag are
+    // less than half of A's diagonal, to the drag part elsewhere.
+    bool any_drag = false;
+    for (const auto i : drag_share.locally_owned_elements())
+    {
+      const bool viscous = drag_share[i] < 0.5;
+      viscous_weight[i]  = viscous ? 1.0 : 0.0;
+      drag_weight[i]     = viscous ? 0.0 : 1.0;
+      any_drag           = any_drag || !viscous;
+    }
+    viscous_weight.compress(dealii::VectorOperation::insert);
+    drag_weight.compress(dealii::VectorOperation::insert);
+    split_velocities =
+      dealii::Utilities::MPI::logical_or(any_drag, mpi_communicator);
+    n_velocity_rows = (split_velocities ? 2 : 1) * n_coarse_velocities;
+    // A pressure node counts unless drag is more than 999 times the
+    // viscous part of the diagonal at its vertex: there the pressure
+    // is held by a mobility 1/beta far below the flow's around it, and
+    // the coarse system's pressure modes inside such a region only add
+    // error (doc/adaptivity.md).
+    drag_share_ghosted = drag_share;
     for (const auto &pair : pressure_vertex_velocity)
-      pressure_weight[pair.first] = velocity_weight_ghosted[pair.second];
+      pressure_weight[pair.first] =
+        drag_share_ghosted[pair.second] < 0.999 ? 1.0 : 0.0;
     pressure_weight.compress(dealii::VectorOperation::insert);
-    // The Galerkin products, block by block.
-    const dealii::TrilinosWrappers::SparseMatrix *interpolation[2] = {
-      &velocity_interpolation, &pressure_interpolation};
-    const dealii::types::global_dof_index offset[2] = {0, n_coarse_velocities};
-    const dealii::IndexSet                coarse_owned =
-      owned_by_root(n_coarse_velocities + n_coarse_pressures, mpi_communicator);
+
+    // The coarse fields: the viscous part W P_u, the drag part
+    // (I - W) P_u where there is drag, the pressure W_p P_p.
+    velocity_part[0] = restrict_rows(restricted_velocity[0],
+                                     velocity_interpolation,
+                                     viscous_weight,
+                                     mpi_communicator);
+    if (split_velocities)
+      velocity_part[1] = restrict_rows(restricted_velocity[1],
+                                       velocity_interpolation,
+                                       drag_weight,
+                                       mpi_communicator);
+    pressure_part = restrict_rows(restricted_pressure,
+                                  pressure_interpolation,
+                                  pressure_weight,
+                                  mpi_communicator);
+    struct Field
+    {
+      const dealii::TrilinosWrappers::SparseMatrix *interpolation;
+      unsigned int                                  block;
+      dealii::types::global_dof_index               offset;
+    };
+    std::vector<Field> fields = {{velocity_part[0], 0, 0}};
+    if (split_velocities)
+      fields.push_back({velocity_part[1], 0, n_coarse_velocities});
+    fields.push_back({pressure_part, 1, n_velocity_rows});
+    const dealii::IndexSet coarse_owned =
+      owned_by_root(n_velocity_rows + n_coarse_pressures, mpi_communicator);
+    if (coarse_rhs.size() != n_velocity_rows + n_coarse_pressures)
+    {
+      coarse_rhs.reinit(coarse_owned, mpi_communicator);
+      coarse_solution.reinit(coarse_owned, mpi_communicator);
+    }
     std::vector<Entry> entries;
-    for (unsigned int bi = 0; bi < 2; ++bi)
-      for (unsigned int bj = 0; bj < 2; ++bj)
+    for (const Field &fi : fields)
+      for (const Field &fj : fields)
       {
-        dealii::TrilinosWrappers::SparseMatrix       product, coarse_block;
-        const dealii::TrilinosWrappers::MPI::Vector *weight[2] = {
-          &velocity_weight, &pressure_weight};
-        system_matrix.block(bi, bj).mmult(product,
-                                          *interpolation[bj],
-                                          *weight[bj]);
-        interpolation[bi]->Tmmult(coarse_block, product, *weight[bi]);
-        const Epetra_CrsMatrix &m = coarse_block.trilinos_matrix();
+        // EpetraExt directly: deal.II's mmult copies the result into a new
+        // matrix, which overran its storage on two ranks where the
+        // restricted interpolation has no rows on one of them.
+        const Epetra_CrsMatrix &fine =
+          system_matrix.block(fi.block, fj.block).trilinos_matrix();
+        const Epetra_CrsMatrix &left  = fi.interpolation->trilinos_matrix();
+        const Epetra_CrsMatrix &right = fj.interpolation->trilinos_matrix();
+        Epetra_CrsMatrix        product(Copy, fine.RowMap(), 0);
+        Epetra_CrsMatrix        m(Copy, left.DomainMap(), 0);
+        AssertThrow(EpetraExt::MatrixMatrix::Multiply(
+                      fine, false, right, false, product) == 0 &&
+                      EpetraExt::MatrixMatrix::Multiply(
+                        left, true, product, false, m) == 0,
+                    dealii::ExcMessage("coarse correction: a sparse matrix "
+                                       "product failed"));
         for (int row = 0; row < m.NumMyRows(); ++row)
         {
           int     n       = 0;
@@ -270,57 +365,57 @@ namespace ImmersedGrains
           int    *indices = nullptr;
           m.ExtractMyRowView(row, n, values, indices);
           const auto global_row =
-            dealii::TrilinosWrappers::global_row_index(m, row) + offset[bi];
-          if (pin_pressure && global_row == n_coarse_velocities)
+            dealii::TrilinosWrappers::global_row_index(m, row) + fi.offset;
+          if (pin_pressure && global_row == n_velocity_rows)
             continue;
           for (int k = 0; k < n; ++k)
             entries.push_back(
               {global_row,
                dealii::TrilinosWrappers::global_column_index(m, indices[k]) +
-                 offset[bj],
+                 fj.offset,
                values[k]});
         }
       }
     // Coarse velocities without a function (no fine DoF sees them, or the
     // weight removed them: no diagonal), then pressures left without a
     // velocity or a diagonal of their own.
-    empty.assign(n_coarse_velocities + n_coarse_pressures, false);
+    empty.assign(n_velocity_rows + n_coarse_pressures, false);
     for (const auto i : coarse_owned)
       empty[i] = true;
     for (const Entry &e : entries)
-      if (e.value != 0 && e.row == e.column && e.row < n_coarse_velocities)
+      if (e.value != 0 && e.row == e.column && e.row < n_velocity_rows)
         empty[e.row] = false;
     for (const Entry &e : entries)
-      if (e.value != 0 && e.row >= n_coarse_velocities &&
+      if (e.value != 0 && e.row >= n_velocity_rows &&
           (e.row == e.column ||
-           (e.column < n_coarse_velocities && !empty[e.column])))
+           (e.column < n_velocity_rows && !empty[e.column])))
         empty[e.row] = false;
     // Where the weights leave more coarse pressures in a region than its
     // velocities can tell apart, S_H is singular: a shift of 10^-8 of a
     // local estimate of its diagonal, sum_j B_ij^2 / A_jj, on the pressure
     // block makes the system regular without touching the modes it does
     // resolve.
-    std::vector<double> velocity_diagonal(n_coarse_velocities, 0.0),
+    std::vector<double> velocity_diagonal(n_velocity_rows, 0.0),
       schur_diagonal(n_coarse_pressures, 0.0);
     for (const Entry &e : entries)
-      if (e.row == e.column && e.row < n_coarse_velocities)
+      if (e.row == e.column && e.row < n_velocity_rows)
         velocity_diagonal[e.row] = e.value;
     // The weights can leave two coarse velocity functions the same fine
     // function (where they keep a single fine node of both): A_H is then
     // singular in a combination whose fine image is zero. A relative shift
     // of its diagonal makes it regular without changing any fine value.
-    for (unsigned int i = 0; i < n_coarse_velocities; ++i)
+    for (unsigned int i = 0; i < n_velocity_rows; ++i)
       if (velocity_diagonal[i] > 0)
         entries.push_back({i, i, 1e-6 * velocity_diagonal[i]});
     for (const Entry &e : entries)
-      if (e.row >= n_coarse_velocities && e.column < n_coarse_velocities &&
+      if (e.row >= n_velocity_rows && e.column < n_velocity_rows &&
           velocity_diagonal[e.column] > 0)
-        schur_diagonal[e.row - n_coarse_velocities] +=
+        schur_diagonal[e.row - n_velocity_rows] +=
           e.value * e.value / velocity_diagonal[e.column];
     for (unsigned int i = 0; i < n_coarse_pressures; ++i)
       if (schur_diagonal[i] > 0)
-        entries.push_back({n_coarse_velocities + i,
-                           n_coarse_velocities + i,
+        entries.push_back({n_velocity_rows + i,
+                           n_velocity_rows + i,
                            -1e-8 * schur_diagonal[i]});
     entries.erase(std::remove_if(entries.begin(),
                                  entries.end(),
@@ -330,7 +425,7 @@ namespace ImmersedGrains
     // Identity rows where a coarse DoF has no operator, and for the pinned
     // pressure.
     for (const auto i : coarse_owned)
-      if (empty[i] || (pin_pressure && i == n_coarse_velocities))
+      if (empty[i] || (pin_pressure && i == n_velocity_rows))
         entries.push_back({i, i, 1.0});
     fill(coarse_matrix, coarse_owned, coarse_owned, entries, mpi_communicator);
 
@@ -347,31 +442,39 @@ namespace ImmersedGrains
     dealii::TrilinosWrappers::MPI::BlockVector       &dst,
     const dealii::TrilinosWrappers::MPI::BlockVector &src) const
   {
-    fine_velocity = src.block(0);
-    fine_velocity.scale(velocity_weight);
-    velocity_interpolation.Tvmult(coarse_velocity, fine_velocity);
-    fine_pressure = src.block(1);
-    fine_pressure.scale(pressure_weight);
-    pressure_interpolation.Tvmult(coarse_pressure, fine_pressure);
-    for (const auto i : coarse_velocity.locally_owned_elements())
-      coarse_rhs[i] = empty[i] ? 0.0 : coarse_velocity[i];
+    const unsigned int parts = split_velocities ? 2 : 1;
+    for (unsigned int part = 0; part < parts; ++part)
+    {
+      velocity_part[part]->Tvmult(coarse_velocity, src.block(0));
+      const auto offset = part * n_coarse_velocities;
+      for (const auto i : coarse_velocity.locally_owned_elements())
+        coarse_rhs[offset + i] = empty[offset + i] ? 0.0 : coarse_velocity[i];
+    }
+    pressure_part->Tvmult(coarse_pressure, src.block(1));
     for (const auto i : coarse_pressure.locally_owned_elements())
-      coarse_rhs[n_coarse_velocities + i] =
-        empty[n_coarse_velocities + i] || (pinned && i == 0) ?
-          0.0 :
-          coarse_pressure[i];
+      coarse_rhs[n_velocity_rows + i] =
+        empty[n_velocity_rows + i] || (pinned && i == 0) ? 0.0 :
+                                                           coarse_pressure[i];
     coarse_rhs.compress(dealii::VectorOperation::insert);
     coarse_solver->solve(coarse_solution, coarse_rhs);
-    for (const auto i : coarse_velocity.locally_owned_elements())
-      coarse_velocity[i] = coarse_solution[i];
+    for (unsigned int part = 0; part < parts; ++part)
+    {
+      const auto offset = part * n_coarse_velocities;
+      for (const auto i : coarse_velocity.locally_owned_elements())
+        coarse_velocity[i] = coarse_solution[offset + i];
+      coarse_velocity.compress(dealii::VectorOperation::insert);
+      if (part == 0)
+        velocity_part[part]->vmult(dst.block(0), coarse_velocity);
+      else
+      {
+        velocity_part[part]->vmult(fine_velocity, coarse_velocity);
+        dst.block(0) += fine_velocity;
+      }
+    }
     for (const auto i : coarse_pressure.locally_owned_elements())
-      coarse_pressure[i] = coarse_solution[n_coarse_velocities + i];
-    coarse_velocity.compress(dealii::VectorOperation::insert);
+      coarse_pressure[i] = coarse_solution[n_velocity_rows + i];
     coarse_pressure.compress(dealii::VectorOperation::insert);
-    velocity_interpolation.vmult(dst.block(0), coarse_velocity);
-    dst.block(0).scale(velocity_weight);
-    pressure_interpolation.vmult(dst.block(1), coarse_pressure);
-    dst.block(1).scale(pressure_weight);
+    pressure_part->vmult(dst.block(1), coarse_pressure);
   }
 
 

@@ -146,21 +146,17 @@ namespace ImmersedGrains
     }
     if (coarse_schur)
     {
-      // The coarse space spans the velocities where the viscous part of
-      // A's diagonal exceeds the mass and drag part (with its floor, at
-      // most 0.3 of the viscous part): where mass or drag dominate, the
-      // velocity is local and the coarse functions would carry the drag
-      // across the region's edge (doc/adaptivity.md).
+      // The share of mass and drag in A's diagonal (with its floor, at
+      // most 0.3 of the viscous part) sorts the fine velocities between
+      // the coarse space's viscous and drag parts (doc/adaptivity.md).
       const auto                           &A = system_matrix.block(0, 0);
-      dealii::TrilinosWrappers::MPI::Vector weight(owned_partitioning[0],
-                                                   mpi_communicator);
+      dealii::TrilinosWrappers::MPI::Vector drag_share(owned_partitioning[0],
+                                                       mpi_communicator);
       for (const auto i : owned_partitioning[0])
-        weight[i] =
-          reaction_diagonal.block(0)[i] < 0.5 * std::abs(A.diag_element(i)) ?
-            1.0 :
-            0.0;
-      weight.compress(dealii::VectorOperation::insert);
-      coarse_schur->build(system_matrix, weight, pressure_has_null_space());
+        drag_share[i] =
+          reaction_diagonal.block(0)[i] / std::abs(A.diag_element(i));
+      drag_share.compress(dealii::VectorOperation::insert);
+      coarse_schur->build(system_matrix, drag_share, pressure_has_null_space());
     }
     // Steady flow without drag in a box at least twice as long as wide:
     // the pressure modes that vary slowly along it are those of Poiseuille

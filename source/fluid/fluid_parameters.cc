@@ -252,23 +252,23 @@ namespace ImmersedGrains
           "iterations (doc/performance.md).");
         prm.declare_entry(
           "Coarse correction",
-          "false",
+          "auto",
           Selection("auto|true|false"),
           "A second level for the block preconditioner: the Stokes problem "
           "on a coarse Taylor-Hood space (the box's coarse mesh refined "
-          "Coarse correction refinement times), its operators the Galerkin "
-          "products of the assembled blocks where viscosity dominates mass "
-          "and drag, solved exactly before each application. It catches "
-          "the pressure modes that vary slowly along an elongated box, which "
-          "the Schur complement approximation misses: steady flow in a 2D "
-          "column 1 x 8 with a region of drag takes 13-22 instead of 25-40 "
-          "FGMRES iterations at a tolerance of 1e-8, in about the same "
-          "time. auto: on for steady flow (Time derivative = false) in 2D "
-          "boxes at least twice as long as their shortest side. Off by "
-          "default: in a packed 2D bed with grains (the coupled_packed_bed_2d "
-          "test scene, a box 36 times as long as high) it took 213 instead "
-          "of 57 iterations, and in 3D and with a time derivative its set-up "
-          "costs more than it saves (doc/adaptivity.md).");
+          "Coarse correction refinement times, its velocities split between "
+          "the regions where viscosity and where mass or drag dominate), its "
+          "operators the Galerkin products of the assembled blocks, solved "
+          "exactly before each application. It catches the pressure modes "
+          "that vary slowly along an elongated box, which the Schur "
+          "complement approximation misses: steady flow in a 2D column "
+          "1 x 8 with a region of drag takes 13-22 instead of 25-40 FGMRES "
+          "iterations at a tolerance of 1e-8, in about the same time, and a "
+          "packed 2D bed across a channel 23 instead of 57 over seven steps. "
+          "auto: on for steady flow (Time derivative = false) in 2D boxes at "
+          "least twice as long as their shortest side; in 3D and with a time "
+          "derivative its set-up costs more than it saves "
+          "(doc/adaptivity.md).");
         prm.declare_entry(
           "Coarse correction refinement",
           "2",

@@ -37,16 +37,20 @@ namespace ImmersedGrains
    * The coarse space is the Q2-Q1 space of the box's coarse mesh refined
    * @p coarse_refinement times, interpolated at the fine DoFs' support
    * points (P_u, P_p; rows of constrained fine DoFs left empty, so every
-   * coarse function is an admissible fine one), and restricted by weights
-   * to the fine velocities where viscosity dominates A (and the pressure
-   * nodes at their vertices): where mass or drag dominate, the velocity is
-   * local, and coarse functions reaching into such a region would carry its
-   * drag into the flow around it. The coarse operators are the Galerkin
-   * products of the assembled blocks, A_H = P_u^T W A W P_u and so on, so
-   * that drag, fluid fraction and viscosity enter as the fine matrix has
-   * them; the coarse system is factorised once per build (Amesos KLU, all
-   * coarse rows on rank 0). Applied, it gives Pi K_H^{-1} Pi^T r with
-   * Pi = diag(W P_u, W_p P_p).
+   * coarse function is an admissible fine one). Its velocities come in two
+   * parts: W P_u on the fine velocities where viscosity dominates A, and
+   * (I - W) P_u on those where mass or drag do (the second only where
+   * there are such). A coarse function reaching into a region of drag
+   * would otherwise carry the region's drag into the flow around it; cut
+   * at the region's edge instead, the coarse space could not carry a flow
+   * through it (a packed bed across a channel). Its pressures are those
+   * away from regions where drag exceeds viscosity a thousandfold (W_p).
+   * The coarse operators are the Galerkin products of the assembled
+   * blocks, A_H = Pi_u^T A Pi_u and so on, so that drag, fluid fraction and
+   * viscosity enter as the fine matrix has them; the coarse system is
+   * factorised once per build (Amesos KLU, all coarse rows on rank 0).
+   * Applied, it gives Pi K_H^{-1} Pi^T r with
+   * Pi = diag([W P_u, (I - W) P_u], W_p P_p).
    */
   class CoarseSchurCorrection
   {
@@ -69,14 +73,16 @@ namespace ImmersedGrains
     ~CoarseSchurCorrection();
 
     /**
-     * The coarse operators of @p system_matrix, factorised, for the weights
-     * @p velocity_weight (1 where a fine velocity belongs to the coarse
-     * space, 0 where not). With @p pin_pressure (no open face: the pressure
+     * The coarse operators of @p system_matrix, factorised. @p drag_share
+     * is, for each owned fine velocity, the share of mass and drag in A's
+     * diagonal; it sorts the fine velocities between the two parts of the
+     * coarse space (below 1/2: viscous) and drops the pressure nodes where
+     * it exceeds 0.999. With @p pin_pressure (no open face: the pressure
      * is fixed up to a constant) the first coarse pressure is held at zero.
      */
     void
     build(const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix,
-          const dealii::TrilinosWrappers::MPI::Vector       &velocity_weight,
+          const dealii::TrilinosWrappers::MPI::Vector       &drag_share,
           bool                                               pin_pressure);
 
     /**
@@ -100,7 +106,19 @@ namespace ImmersedGrains
     dealii::types::global_dof_index        n_coarse_pressures  = 0;
     dealii::TrilinosWrappers::SparseMatrix velocity_interpolation;
     dealii::TrilinosWrappers::SparseMatrix pressure_interpolation;
-    bool                                   pinned = false;
+    // The interpolations restricted by the weights of the last build()
+    // (the velocities' viscous and drag parts, the pressure), and each
+    // part's interpolation: the restricted one, or the whole one where
+    // the weights keep every row.
+    dealii::TrilinosWrappers::SparseMatrix        restricted_velocity[2];
+    dealii::TrilinosWrappers::SparseMatrix        restricted_pressure;
+    const dealii::TrilinosWrappers::SparseMatrix *velocity_part[2] = {nullptr,
+                                                                      nullptr};
+    const dealii::TrilinosWrappers::SparseMatrix *pressure_part    = nullptr;
+    bool                                          pinned           = false;
+    // Whether the coarse velocities have a drag part, and their number.
+    bool                            split_velocities = false;
+    dealii::types::global_dof_index n_velocity_rows  = 0;
     // Coarse DoFs the last build() left without an operator (no fine DoF
     // sees them, or the weights removed them): identity rows.
     std::vector<bool> empty;
@@ -113,11 +131,11 @@ namespace ImmersedGrains
     mutable dealii::TrilinosWrappers::MPI::Vector coarse_velocity;
     mutable dealii::TrilinosWrappers::MPI::Vector coarse_rhs;
     mutable dealii::TrilinosWrappers::MPI::Vector coarse_solution;
-    mutable dealii::TrilinosWrappers::MPI::Vector fine_pressure;
     mutable dealii::TrilinosWrappers::MPI::Vector fine_velocity;
-    dealii::TrilinosWrappers::MPI::Vector         velocity_weight;
+    dealii::TrilinosWrappers::MPI::Vector         viscous_weight;
+    dealii::TrilinosWrappers::MPI::Vector         drag_weight;
     dealii::TrilinosWrappers::MPI::Vector         pressure_weight;
-    dealii::TrilinosWrappers::MPI::Vector         velocity_weight_ghosted;
+    dealii::TrilinosWrappers::MPI::Vector         drag_share_ghosted;
     // Each owned fine pressure's vertex: the velocity DoF there.
     std::map<dealii::types::global_dof_index, dealii::types::global_dof_index>
       pressure_vertex_velocity;
