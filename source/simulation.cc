@@ -654,6 +654,7 @@ namespace ImmersedGrains
       dealii::TimerOutput::Scope scope(*timer, "adaptation");
       if (!adaptivity->mark_cells(grains ? &grains->particle_handler() :
                                            nullptr,
+                                  grains ? grains->layout().radius : 0,
                                   fluid.get()))
         return false;
     }

@@ -9,10 +9,12 @@
 #include <deal.II/numerics/error_estimator.h>
 
 #include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/grains/grain_parameters.h>
 #include <immersed_grains/mesh/adaptivity.h>
 #include <immersed_grains/parameters.h>
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 
@@ -150,6 +152,18 @@ namespace ImmersedGrains
                         Double(0, 1),
                         "Criteria = velocity: the share of cells coarsened.");
       prm.declare_entry(
+        "Minimum solid fraction",
+        "0",
+        Double(0, 1),
+        "Criteria = grains: the grains in a cell start the band only where "
+        "they fill at least this fraction of the volume (area in 2D) of a "
+        "cell of the finest size within it; 0: any grain. Above 0, grains "
+        "that have left a cloud one by one (the tail of its wake) stay on "
+        "the coarse mesh, where they settle in the flow the cloud makes, "
+        "and the fine mesh stays on the cloud (doc/adaptivity.md). One grain "
+        "of diameter d in a cell of edge h fills (pi/6)(d/h)^3 of it in 3D, "
+        "(pi/4)(d/h)^2 in 2D.");
+      prm.declare_entry(
         "Minimum cell size",
         "2",
         Double(0),
@@ -194,10 +208,11 @@ namespace ImmersedGrains
       velocity_kelly =
         std::find(criteria.begin(), criteria.end(), "velocity") !=
         criteria.end();
-      band_width       = prm.get_integer("Band width");
-      refine_fraction  = prm.get_double("Refine fraction");
-      coarsen_fraction = prm.get_double("Coarsen fraction");
-      min_cell_size    = prm.get_double("Minimum cell size");
+      band_width         = prm.get_integer("Band width");
+      refine_fraction    = prm.get_double("Refine fraction");
+      coarsen_fraction   = prm.get_double("Coarsen fraction");
+      min_cell_size      = prm.get_double("Minimum cell size");
+      min_solid_fraction = prm.get_double("Minimum solid fraction");
       if (enabled)
       {
         where.require(min_level <= max_level,
@@ -233,9 +248,53 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  bool
+  Adaptivity<dim>::dense_enough(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const dealii::Particles::ParticleHandler<dim>                   &grains,
+    const unsigned int radius_property) const
+  {
+    if (parameters.min_solid_fraction <= 0)
+      return true;
+    // The cell's finest descendants: halved while levels remain and the
+    // children stay above the floor (as mark_cells() refines).
+    unsigned int n    = 1;
+    double       edge = cell->minimum_vertex_distance();
+    for (unsigned int level = cell->level();
+         level < parameters.max_level && edge >= 2 * smallest_cell;
+         ++level, edge /= 2)
+      n *= 2;
+    const dealii::Point<dim> corner = cell->vertex(0);
+    const dealii::Point<dim> far    = cell->vertex((1 << dim) - 1);
+    const double             needed =
+      parameters.min_solid_fraction * cell->measure() / std::pow(n, dim);
+    std::map<unsigned int, double> filled;
+    for (const auto &grain : grains.particles_in_cell(cell))
+    {
+      unsigned int bin = 0, stride = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double xi =
+          (grain.get_location()[d] - corner[d]) / (far[d] - corner[d]);
+        bin += stride * std::min(n - 1,
+                                 static_cast<unsigned int>(
+                                   std::max(0.0, std::floor(xi * n))));
+        stride *= n;
+      }
+      double &volume = filled[bin];
+      volume += grain_volume<dim>(grain.get_properties()[radius_property]);
+      if (volume >= needed)
+        return true;
+    }
+    return false;
+  }
+
+
+  template <int dim>
   std::vector<unsigned int>
   Adaptivity<dim>::grain_band(
-    const dealii::Particles::ParticleHandler<dim> &grains) const
+    const dealii::Particles::ParticleHandler<dim> &grains,
+    const unsigned int                             radius_property) const
   {
     // One value per cell with ghosts: a DG0 field.
     dealii::DoFHandler<dim>   cells(triangulation);
@@ -248,7 +307,8 @@ namespace ImmersedGrains
 
     std::vector<dealii::types::global_dof_index> index(1);
     for (const auto &cell : cells.active_cell_iterators())
-      if (cell->is_locally_owned() && grains.n_particles_in_cell(cell) > 0)
+      if (cell->is_locally_owned() && grains.n_particles_in_cell(cell) > 0 &&
+          dense_enough(cell, grains, radius_property))
       {
         cell->get_dof_indices(index);
         marked[index[0]] = 1;
@@ -349,6 +409,7 @@ namespace ImmersedGrains
   bool
   Adaptivity<dim>::mark_cells(
     const dealii::Particles::ParticleHandler<dim> *grains,
+    const unsigned int                             radius_property,
     const FluidSolver<dim>                        *fluid)
   {
     for (const auto &cell : triangulation.active_cell_iterators())
@@ -381,7 +442,7 @@ namespace ImmersedGrains
 
     std::vector<unsigned int> band;
     if (parameters.around_grains && grains != nullptr)
-      band = grain_band(*grains);
+      band = grain_band(*grains, radius_property);
 
     for (const auto &cell : triangulation.active_cell_iterators())
     {

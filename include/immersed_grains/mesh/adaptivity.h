@@ -47,6 +47,9 @@ namespace ImmersedGrains
       double       refine_fraction  = 0.1;
       double       coarsen_fraction = 0.3;
       double       min_cell_size    = 1; // grain diameters
+      /** Solid fraction a Max-level cell's volume must hold for the grains
+       *  in it to start the band (0: any grain). */
+      double min_solid_fraction = 0;
     };
 
     /** @p smallest_cell: no cell is refined into children smaller than
@@ -62,6 +65,7 @@ namespace ImmersedGrains
      */
     bool
     mark_cells(const dealii::Particles::ParticleHandler<dim> *grains,
+               unsigned int                                   radius_property,
                const FluidSolver<dim>                        *fluid);
 
     /**
@@ -94,7 +98,17 @@ namespace ImmersedGrains
      *  exchanged between layers, so that the band does not depend on the
      *  partition. */
     std::vector<unsigned int>
-    grain_band(const dealii::Particles::ParticleHandler<dim> &grains) const;
+    grain_band(const dealii::Particles::ParticleHandler<dim> &grains,
+               unsigned int radius_property) const;
+
+    /** Whether the grains in @p cell fill at least Minimum solid fraction of
+     *  the volume of some cell of the finest size the cell can be refined
+     *  to (Max level and the cell-size floor) within it. */
+    bool
+    dense_enough(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const dealii::Particles::ParticleHandler<dim>                   &grains,
+      unsigned int radius_property) const;
 
     const Parameters                                  &parameters;
     dealii::parallel::distributed::Triangulation<dim> &triangulation;
