@@ -38,21 +38,27 @@
 using namespace dealii;
 using namespace ImmersedGrains;
 
-class Ball : public Function<2>
+// A field that takes one value inside the drag region (the ball, or the
+// bed across the column) and another outside.
+class Region : public Function<2>
 {
 public:
-  Ball(const double inside, const double outside)
-      : inside(inside)
+  Region(const bool bed, const double inside, const double outside)
+      : bed(bed)
+      , inside(inside)
       , outside(outside)
   {
   }
   double
   value(const Point<2> &x, unsigned int) const override
   {
-    return x.distance(Point<2>(0.5, 6)) < 0.3 ? inside : outside;
+    const bool in =
+      bed ? std::abs(x[1] - 4.5) < 2.5 : x.distance(Point<2>(0.5, 6)) < 0.3;
+    return in ? inside : outside;
   }
 
 private:
+  bool   bed;
   double inside, outside;
 };
 
@@ -69,24 +75,6 @@ public:
     const double s = std::sin(M_PI * x[0]) * std::sin(M_PI * x[1]);
     return i == 0 ? s * (x[1] - 0.5) : -s * (x[0] - 0.5) + 1.0;
   }
-};
-
-class Layer : public Function<2>
-{
-public:
-  Layer(const double inside, const double outside)
-      : inside(inside)
-      , outside(outside)
-  {
-  }
-  double
-  value(const Point<2> &x, unsigned int) const override
-  {
-    return std::abs(x[1] - 4.5) < 2.5 ? inside : outside;
-  }
-
-private:
-  double inside, outside;
 };
 
 struct Solution
@@ -136,19 +124,12 @@ solve_column(const bool         coarse_correction,
   parallel::distributed::Triangulation<2> tria(MPI_COMM_WORLD);
   geometry.create_mesh(tria);
   FluidSolver<2> fluid(parameters, geometry, tria, timer, pcout);
-  if (bed)
-    fluid.set_mixture_fields(std::make_shared<PrescribedMixtureFields<2>>(
-      std::make_shared<Layer>(0.4, 1.0),
-      std::make_shared<Layer>(beta, 0.0),
-      std::make_shared<Functions::ZeroFunction<2>>(2)));
-  else
-  {
-    fluid.set_mixture_fields(std::make_shared<PrescribedMixtureFields<2>>(
-      std::make_shared<Ball>(0.35, 1.0),
-      std::make_shared<Ball>(beta, 0.0),
-      std::make_shared<Functions::ZeroFunction<2>>(2)));
+  fluid.set_mixture_fields(std::make_shared<PrescribedMixtureFields<2>>(
+    std::make_shared<Region>(bed, bed ? 0.4 : 0.35, 1.0),
+    std::make_shared<Region>(bed, beta, 0.0),
+    std::make_shared<Functions::ZeroFunction<2>>(2)));
+  if (!bed)
     fluid.set_forcing(std::make_shared<Swirl>());
-  }
   fluid.setup_dofs();
   fluid.set_initial_condition();
   try
