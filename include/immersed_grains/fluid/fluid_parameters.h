@@ -59,9 +59,13 @@ namespace ImmersedGrains
     double       nonlinear_tolerance      = 1e-8;
     unsigned int max_nonlinear_iterations = 20;
 
-    bool               direct_solver         = false;
-    double             linear_tolerance      = 1e-8;
-    unsigned int       max_linear_iterations = 500;
+    bool         direct_solver         = false;
+    double       linear_tolerance      = 1e-8;
+    unsigned int max_linear_iterations = 500;
+    // FGMRES goes on while its velocity error, estimated as the velocity
+    // part of P^-1 r, exceeds this fraction of the largest velocity (0:
+    // never).
+    double             velocity_error_tolerance = 0.05;
     SchurApproximation schur_approximation =
       SchurApproximation::cahouet_chabard;
     // The velocity block's approximate inverse: AMG V-cycles, one ILU

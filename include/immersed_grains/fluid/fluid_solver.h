@@ -386,9 +386,14 @@ namespace ImmersedGrains
     // last rebuild, whether a slower solve asked for a new one, and the
     // mass coefficient it was built for.
     unsigned int iterations_after_rebuild = 0;
-    unsigned int builds                   = 0; // since the start
-    bool         rebuild_requested        = false;
-    double       built_mass_coefficient   = 0;
+    // The velocity-error check (Linear solver/Velocity error tolerance):
+    // the factor its last finding put on Tolerance, and the solves since
+    // it last ran.
+    double       velocity_tolerance_factor   = 1;
+    unsigned int solves_since_velocity_check = 0;
+    unsigned int builds                      = 0; // since the start
+    bool         rebuild_requested           = false;
+    double       built_mass_coefficient      = 0;
 
     // DataOut keeps a pointer to the postprocessor until patches are built.
     mutable std::unique_ptr<dealii::DataPostprocessor<dim>> output_fields;
