@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 
@@ -268,10 +269,11 @@ namespace ImmersedGrains
     const dealii::Point<dim> far    = cell->vertex((1 << dim) - 1);
     const double             needed =
       parameters.min_solid_fraction * cell->measure() / std::pow(n, dim);
-    std::map<unsigned int, double> filled;
+    // Up to 12 levels apart in 3D the bins number 2^36: 64-bit indices.
+    std::map<std::uint64_t, double> filled;
     for (const auto &grain : grains.particles_in_cell(cell))
     {
-      unsigned int bin = 0, stride = 1;
+      std::uint64_t bin = 0, stride = 1;
       for (unsigned int d = 0; d < dim; ++d)
       {
         const double xi =
