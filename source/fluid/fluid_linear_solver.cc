@@ -10,6 +10,7 @@
 #include <immersed_grains/fluid/block_preconditioner.h>
 #include <immersed_grains/fluid/coarse_schur_correction.h>
 #include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/fluid/trilinos_rows.h>
 
 #include <cmath>
 #include <limits>
@@ -20,37 +21,6 @@
 
 namespace ImmersedGrains
 {
-  namespace
-  {
-    // Calls f(row, columns, values) for every locally owned row of
-    // @p matrix, with global indices, through Epetra's views of its rows.
-    // deal.II's iterators copy the whole row into a cache at begin() and
-    // again at end(): the loops below spent 15 % of a three-step 3D run
-    // there (perf, Lethe's scene).
-    template <typename RowFunction>
-    void
-    for_each_owned_row(const dealii::TrilinosWrappers::SparseMatrix &matrix,
-                       const RowFunction                            &f)
-    {
-      const Epetra_CrsMatrix                      &m = matrix.trilinos_matrix();
-      std::vector<dealii::types::global_dof_index> columns;
-      for (int row = 0; row < m.NumMyRows(); ++row)
-      {
-        int     n       = 0;
-        double *values  = nullptr;
-        int    *indices = nullptr;
-        m.ExtractMyRowView(row, n, values, indices);
-        columns.resize(n);
-        for (int k = 0; k < n; ++k)
-          columns[k] =
-            dealii::TrilinosWrappers::global_column_index(m, indices[k]);
-        f(static_cast<dealii::types::global_dof_index>(
-            dealii::TrilinosWrappers::global_row_index(m, row)),
-          columns,
-          values);
-      }
-    }
-  } // namespace
 
 
   template <int dim>
@@ -220,7 +190,7 @@ namespace ImmersedGrains
                                                           mpi_communicator);
         for (const auto i : owned_partitioning[1])
           pattern.add(i, i);
-        for_each_owned_row(product,
+        for_each_owned_row(product.trilinos_matrix(),
                            [&](const auto row, const auto &columns, auto) {
                              pattern.add_entries(row,
                                                  columns.begin(),
@@ -233,7 +203,7 @@ namespace ImmersedGrains
       double       mean     = 0;
       unsigned int n        = 0;
       for_each_owned_row(
-        product,
+        product.trilinos_matrix(),
         [&](const auto row, const auto &columns, const double *values)
         {
           schur_diagonal_matrix.set(
@@ -251,7 +221,7 @@ namespace ImmersedGrains
       // lies within the product's.
       std::vector<double> negated;
       for_each_owned_row(
-        system_matrix.block(1, 1),
+        system_matrix.block(1, 1).trilinos_matrix(),
         [&](const auto row, const auto &columns, const double *values)
         {
           negated.assign(values, values + columns.size());
