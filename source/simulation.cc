@@ -814,6 +814,50 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::string
+  Simulation<dim>::saved_physics_description() const
+  {
+    // What decides the layout of the saved fields and grains: a run with
+    // other physics would read them as something else (a frictionless
+    // pile's 4 numbers per grain read as 7 gave grains at infinite speed).
+    std::string text = std::string("fluid ") +
+                       (fluid_parameters.enabled ? "on" : "off") + ", grains ";
+    if (!grain_parameters.enabled)
+      return text + "off";
+    const GrainPropertyLayout layout =
+      make_grain_property_layout(grain_parameters, fluid_parameters.enabled);
+    text += "with " + std::to_string(layout.n_properties) + " properties (";
+    for (unsigned int k = 0; k < layout.names.size(); ++k)
+      if (k == 0 || layout.names[k] != layout.names[k - 1])
+        text += (k == 0 ? "" : ", ") + layout.names[k];
+    return text + ")";
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::check_saved_physics(const std::string &directory) const
+  {
+    // Checkpoints written before this file existed are taken as they are.
+    std::ifstream in(directory + "/physics.txt");
+    std::string   saved;
+    if (!std::getline(in, saved))
+      return;
+    const std::string wanted = saved_physics_description();
+    if (saved != wanted)
+      InputLocation{parameter_file, "Checkpoint"}.fail(
+        "Resume",
+        checkpoint_parameters.resume == Checkpoint::Resume::always ? "true" :
+                                                                     "auto",
+        directory + " was written with " + saved + "; this scene has " +
+          wanted +
+          ": resume with the settings it was written with (Fluid/Enabled, "
+          "Grains/Enabled, Contacts/Friction and the coupling decide these), "
+          "or start afresh with Resume = false");
+  }
+
+
+  template <int dim>
   void
   Simulation<dim>::save_state(const std::string &directory) const
   {
@@ -840,6 +884,9 @@ namespace ImmersedGrains
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
+    std::ofstream physics(directory + "/physics.txt");
+    physics << saved_physics_description() << '\n';
+    AssertThrow(physics, dealii::ExcMessage("Cannot write " + directory));
     std::filesystem::rename(directory + "/state.txt.part",
                             directory + "/state.txt");
   }
@@ -934,6 +981,8 @@ namespace ImmersedGrains
       AssertThrow(state && resumed_step >= 0,
                   dealii::ExcMessage("Checkpoint: cannot read " + resume_from +
                                      "/state.txt"));
+      // Before anything in the output directory is touched.
+      check_saved_physics(resume_from);
     }
 
     // Created only now: a TimerOutput alive while a parse error unwinds

@@ -14,7 +14,9 @@
 // straight two-rank run. The same again with Adaptivity/Every steps =
 // auto, whose schedule depends on the grains' travel since the last
 // adaptation: that sum must survive the restart. Last, a fresh run in a
-// directory that holds another run's checkpoints keeps only its own.
+// directory that holds another run's checkpoints keeps only its own, and
+// a resume with other physics (friction added) stops with an input error
+// that names Checkpoint/Resume and leaves the run as it was.
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 
@@ -72,6 +74,32 @@ main(int argc, char **argv)
   run("straight", 0.5, false);
   run("resumed", 0.25, false);
   run("resumed", 0.5, true);
+
+  // Friction gives each grain an angular velocity: a checkpoint written
+  // without it holds fewer numbers per grain, which a resume with friction
+  // would read as something else (a 10^4-sphere pile came back with 7786
+  // grains at infinite speed). It must stop with an input error naming
+  // Checkpoint/Resume, before it changes anything.
+  std::string friction_error;
+  const auto  log_size = [](const std::string &directory)
+  {
+    return std::filesystem::exists(directory + "/log.txt") ?
+             std::filesystem::file_size(directory + "/log.txt") :
+             std::uintmax_t(0);
+  };
+  const std::uintmax_t log_before = log_size("resumed");
+  try
+  {
+    run("resumed",
+        0.75,
+        true,
+        MPI_COMM_WORLD,
+        "subsection Contacts\n  set Friction = 0.3\nend\n");
+  }
+  catch (const InputError &e)
+  {
+    friction_error = e.what();
+  }
 
   // Every steps = auto adapts by how far the grains went since the last
   // adaptation, a sum the checkpoint carries: on cells of 62.5 um (Max
@@ -152,6 +180,16 @@ main(int argc, char **argv)
   std::cout << "rows: straight " << straight.size() - 1 << ", resumed "
             << resumed.size() - 1 << '\n';
   compare(straight, resumed);
+
+  std::cout << "a resume with friction added stops with an input error "
+               "naming Checkpoint/Resume: "
+            << (friction_error.find("Checkpoint/Resume") != std::string::npos &&
+                    friction_error.find("angular_velocity") !=
+                      std::string::npos ?
+                  "yes" :
+                  "no")
+            << ", before writing to the run's log: "
+            << (log_size("resumed") == log_before ? "yes" : "no") << '\n';
 
   std::ifstream log("resumed/log.txt");
   std::string   text((std::istreambuf_iterator<char>(log)),

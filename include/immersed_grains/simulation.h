@@ -90,6 +90,13 @@ namespace ImmersedGrains
     save_state(const std::string &directory) const;
     void
     load_state(const std::string &directory);
+    // One line naming what decides the layout of the saved state (fluid on
+    // or off, the grains' properties), written with each checkpoint; a
+    // resume with other physics stops with an input error.
+    std::string
+    saved_physics_description() const;
+    void
+    check_saved_physics(const std::string &directory) const;
     // Refines and coarsens the mesh by the Adaptivity criteria and moves
     // every state onto it; false if nothing changed.
     bool

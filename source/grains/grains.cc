@@ -12,48 +12,45 @@
 
 namespace ImmersedGrains
 {
-  namespace
+  template <int dim>
+  GrainPropertyLayout
+  make_grain_property_layout(const GrainParameters<dim> &prm,
+                             const bool                  with_fluid)
   {
-    template <int dim>
-    GrainPropertyLayout
-    make_layout(const GrainParameters<dim> &prm, const bool with_fluid)
+    using namespace dealii::DataComponentInterpretation;
+    GrainPropertyLayout l;
+    const auto          add =
+      [&](const std::string &name, const unsigned int n, const bool vector)
     {
-      using namespace dealii::DataComponentInterpretation;
-      GrainPropertyLayout l;
-      const auto          add =
-        [&](const std::string &name, const unsigned int n, const bool vector)
+      const unsigned int first = l.n_properties;
+      for (unsigned int c = 0; c < n; ++c)
       {
-        const unsigned int first = l.n_properties;
-        for (unsigned int c = 0; c < n; ++c)
-        {
-          l.names.push_back(name);
-          l.interpretations.push_back(vector ? component_is_part_of_vector :
-                                               component_is_scalar);
-        }
-        l.n_properties += n;
-        return first;
-      };
-      l.velocity = add("velocity", dim, true);
-      l.radius   = add("radius", 1, false);
-      if (prm.contacts_enabled && prm.contact.friction > 0)
-        l.angular_velocity =
-          add("angular_velocity", dim == 2 ? 1 : 3, dim == 3);
-      if (with_fluid)
-      {
-        l.fluid_force   = add("fluid_force", dim, true);
-        l.drag_force    = add("drag_force", dim, true);
-        l.self_velocity = add("self_velocity", dim, true);
+        l.names.push_back(name);
+        l.interpretations.push_back(vector ? component_is_part_of_vector :
+                                             component_is_scalar);
       }
-      if (with_fluid && prm.contacts_enabled)
-      {
-        l.contact_impulse   = add("contact_impulse", dim, true);
-        l.predicted_impulse = add("predicted_impulse", dim, true);
-      }
-      if (prm.has_fixed_region)
-        l.fixed = add("fixed", 1, false);
-      return l;
+      l.n_properties += n;
+      return first;
+    };
+    l.velocity = add("velocity", dim, true);
+    l.radius   = add("radius", 1, false);
+    if (prm.contacts_enabled && prm.contact.friction > 0)
+      l.angular_velocity = add("angular_velocity", dim == 2 ? 1 : 3, dim == 3);
+    if (with_fluid)
+    {
+      l.fluid_force   = add("fluid_force", dim, true);
+      l.drag_force    = add("drag_force", dim, true);
+      l.self_velocity = add("self_velocity", dim, true);
     }
-  } // namespace
+    if (with_fluid && prm.contacts_enabled)
+    {
+      l.contact_impulse   = add("contact_impulse", dim, true);
+      l.predicted_impulse = add("predicted_impulse", dim, true);
+    }
+    if (prm.has_fixed_region)
+      l.fixed = add("fixed", 1, false);
+    return l;
+  }
 
 
   template <int dim>
@@ -68,7 +65,7 @@ namespace ImmersedGrains
       , triangulation(tria)
       , comm(tria.get_communicator())
       , timer(timer)
-      , properties(make_layout(parameters, with_fluid))
+      , properties(make_grain_property_layout(parameters, with_fluid))
       , particles(tria, mapping, properties.n_properties)
       , vertex_cache(tria, mapping)
   {
@@ -1007,6 +1004,10 @@ namespace ImmersedGrains
   }
 
 
+  template GrainPropertyLayout
+  make_grain_property_layout(const GrainParameters<2> &, bool);
+  template GrainPropertyLayout
+  make_grain_property_layout(const GrainParameters<3> &, bool);
   template class Grains<2>;
   template class Grains<3>;
 } // namespace ImmersedGrains

@@ -52,6 +52,13 @@ namespace ImmersedGrains
       interpretations;
   };
 
+  /** The layout a scene's grains get from its parameters: with a fluid
+   *  (@p with_fluid), friction, contacts and a fixed region. */
+  template <int dim>
+  GrainPropertyLayout
+  make_grain_property_layout(const GrainParameters<dim> &parameters,
+                             bool                        with_fluid);
+
   /**
    * The arrays of one step, gathered once from the ParticleHandler in its
    * iteration order (owned grains of this rank). The coupling hooks are
