@@ -852,8 +852,8 @@ namespace ImmersedGrains
         directory + " was written with " + saved + "; this scene has " +
           wanted +
           ": resume with the settings it was written with (Fluid/Enabled, "
-          "Grains/Enabled, Contacts/Friction and the coupling decide these), "
-          "or start afresh with Resume = false");
+          "Grains/Enabled, Contacts/Enabled, Contacts/Friction and a fixed "
+          "region decide these), or start afresh with Resume = false");
   }
 
 
@@ -886,6 +886,7 @@ namespace ImmersedGrains
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
     std::ofstream physics(directory + "/physics.txt");
     physics << saved_physics_description() << '\n';
+    physics.close();
     AssertThrow(physics, dealii::ExcMessage("Cannot write " + directory));
     std::filesystem::rename(directory + "/state.txt.part",
                             directory + "/state.txt");
