@@ -8,6 +8,7 @@
 #include <immersed_grains/mesh/size_estimate.h>
 #include <immersed_grains/simulation.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -539,7 +540,8 @@ namespace ImmersedGrains
                                              geometry,
                                              triangulation,
                                              fluid_parameters.enabled,
-                                             *timer);
+                                             *timer,
+                                             follows_straight_paths());
       // A resumed run does not place its grains again.
       if (resumed)
         grains->deserialize();
@@ -607,6 +609,7 @@ namespace ImmersedGrains
     {
       adaptivity =
         std::make_unique<Adaptivity<dim>>(adaptivity_parameters,
+                                          geometry,
                                           triangulation,
                                           adaptivity_parameters.min_cell_size *
                                             2 * largest_grain_radius);
@@ -634,6 +637,18 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  bool
+  Simulation<dim>::follows_straight_paths() const
+  {
+    // (Before the grains and the adaptivity exist: from the parameters.)
+    return adaptivity_parameters.enabled && grain_parameters.enabled &&
+           fluid_parameters.enabled && adaptivity_parameters.follow_grains &&
+           adaptivity_parameters.around_grains &&
+           adaptivity_parameters.band_lookahead > 0;
+  }
+
+
+  template <int dim>
   void
   Simulation<dim>::update_shortest_cell_edge()
   {
@@ -649,19 +664,38 @@ namespace ImmersedGrains
   bool
   Simulation<dim>::adapt_mesh()
   {
-    const double start = now();
+    const double                              start = now();
+    typename Adaptivity<dim>::GrainProperties properties;
+    if (grains)
+    {
+      properties.radius   = grains->layout().radius;
+      properties.velocity = grains->layout().velocity;
+    }
+    const auto mark = [&](const bool refine_only)
     {
       dealii::TimerOutput::Scope scope(*timer, "adaptation");
-      if (!adaptivity->mark_cells(grains ? &grains->particle_handler() :
-                                           nullptr,
-                                  grains ? grains->layout().radius : 0,
-                                  fluid.get()))
-        return false;
-    }
+      return adaptivity->mark_cells(grains ? &grains->particle_handler() :
+                                             nullptr,
+                                    properties,
+                                    fluid.get(),
+                                    shortest_cell_edge,
+                                    refine_only);
+    };
+    if (!mark(false))
+      return false;
     change_mesh([this]()
                 { triangulation.execute_coarsening_and_refinement(); });
-    pdetail << "  mesh adapted before step " << step + 1 << ": "
-            << triangulation.n_global_active_cells() << " cells, "
+    // The lookahead band reaches cells several levels coarser than its
+    // own: they climb a level per pass.
+    unsigned int passes = 1;
+    if (adaptivity_parameters.band_lookahead > 0)
+      for (; passes <= adaptivity_parameters.max_level && mark(true); ++passes)
+        change_mesh([this]()
+                    { triangulation.execute_coarsening_and_refinement(); });
+    pdetail << "  mesh adapted before step " << step + 1;
+    if (passes > 1)
+      pdetail << " in " << passes << " passes";
+    pdetail << ": " << triangulation.n_global_active_cells() << " cells, "
             << (fluid ? fluid->n_dofs() : 0) << " fluid DoFs, "
             << std::setprecision(3) << now() - start << " s";
     if (load_balance)
@@ -715,6 +749,17 @@ namespace ImmersedGrains
         step_start_speed   = statistics.get("max_speed");
         const double ahead = step_start_speed * next_time_step();
         reach              = grain_travel + ahead;
+        // Within the lookahead the band holds every grain that strays
+        // from its straight path by less than the allowance, however far
+        // it went along it.
+        const double horizon = adaptivity->lookahead_horizon();
+        if (horizon > 0 && time + next_time_step() - band_made_at <= horizon)
+        {
+          const auto &drift = grains->straight_path_drift();
+          reach =
+            std::min(reach,
+                     drift.displacement + next_time_step() * drift.velocity);
+        }
         // (Band width = 0 asks for no margin: nothing to warn about.)
         if (!warned_band_outrun && adaptivity_parameters.band_width > 0 &&
             ahead > 2 * adaptivity->travel_allowance(shortest_cell_edge))
@@ -737,6 +782,9 @@ namespace ImmersedGrains
       {
         // The band is made around where the grains are now.
         grain_travel = 0;
+        if (grains)
+          grains->reset_straight_paths();
+        band_made_at = time;
         if (adapt_mesh())
           return;
       }
@@ -825,7 +873,9 @@ namespace ImmersedGrains
     if (!grain_parameters.enabled)
       return text + "off";
     const GrainPropertyLayout layout =
-      make_grain_property_layout(grain_parameters, fluid_parameters.enabled);
+      make_grain_property_layout(grain_parameters,
+                                 fluid_parameters.enabled,
+                                 follows_straight_paths());
     text += "with " + std::to_string(layout.n_properties) + " properties (";
     for (unsigned int k = 0; k < layout.names.size(); ++k)
       if (k == 0 || layout.names[k] != layout.names[k - 1])
@@ -852,8 +902,9 @@ namespace ImmersedGrains
         directory + " was written with " + saved + "; this scene has " +
           wanted +
           ": resume with the settings it was written with (Fluid/Enabled, "
-          "Grains/Enabled, Contacts/Enabled, Contacts/Friction and a fixed "
-          "region decide these), or start afresh with Resume = false");
+          "Grains/Enabled, Contacts/Enabled, Contacts/Friction, a fixed "
+          "region and Adaptivity/Band lookahead decide these), or start "
+          "afresh with Resume = false");
   }
 
 
@@ -881,6 +932,14 @@ namespace ImmersedGrains
         out << std::hexfloat << t << ' ' << file << '\n';
     }
     out << "grain_travel " << std::hexfloat << grain_travel << '\n';
+    {
+      const StraightPathDrift drift =
+        grains ? grains->straight_path_drift() : StraightPathDrift();
+      out << "band_lookahead " << std::hexfloat
+          << (adaptivity ? adaptivity->lookahead_horizon() : 0.0) << ' '
+          << band_made_at << ' ' << drift.displacement << ' ' << drift.velocity
+          << '\n';
+    }
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
@@ -931,6 +990,28 @@ namespace ImmersedGrains
     {
       in.clear();
       in.seekg(position);
+    }
+    // Absent before Adaptivity/Band lookahead: the band then lasts until
+    // the grains have travelled its allowance.
+    const auto lookahead_position = in.tellg();
+    if (in >> text && text == "band_lookahead")
+    {
+      std::array<double, 4> values;
+      for (double &v : values)
+      {
+        in >> text;
+        v = std::strtod(text.c_str(), nullptr);
+      }
+      if (adaptivity)
+        adaptivity->set_lookahead_horizon(values[0]);
+      band_made_at = values[1];
+      if (grains)
+        grains->straight_path_drift() = {values[2], values[3]};
+    }
+    else
+    {
+      in.clear();
+      in.seekg(lookahead_position);
     }
     statistics.load_values(in);
     AssertThrow(!in.bad(),

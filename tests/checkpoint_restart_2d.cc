@@ -13,7 +13,9 @@
 // grain kept, the centroid within 0.1 % of the distance fallen of the
 // straight two-rank run. The same again with Adaptivity/Every steps =
 // auto, whose schedule depends on the grains' travel since the last
-// adaptation: that sum must survive the restart. Last, a fresh run in a
+// adaptation: that sum must survive the restart; and with Band lookahead,
+// whose schedule depends on when the band was made and on each grain's
+// deviation from its straight path. Last, a fresh run in a
 // directory that holds another run's checkpoints keeps only its own, and
 // a resume with other physics (friction added) stops with an input error
 // that names Checkpoint/Resume and leaves the run as it was.
@@ -27,6 +29,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -116,6 +119,24 @@ main(int argc, char **argv)
   run("straight_auto", 0.5, false, MPI_COMM_WORLD, by_travel);
   run("resumed_auto", 0.25, false, MPI_COMM_WORLD, by_travel);
   run("resumed_auto", 0.5, true, MPI_COMM_WORLD, by_travel);
+
+  // With Band lookahead = 1 the band made before step 4 (the grains start
+  // at rest, so the first is made by their travel) covers one cell (4
+  // steps) of each grain's path. The schedule then depends on when the
+  // band was made and on each grain's deviation from its path (grain
+  // properties): the resumed run must carry both across the checkpoint of
+  // step 4 to adapt again before step 7, as the straight run does.
+  const std::string lookahead = "subsection Adaptivity\n  set Every steps = "
+                                "auto\n  set Max level = 5\n  set Band "
+                                "lookahead = 1\nend\n";
+  if (root)
+  {
+    std::filesystem::remove_all("straight_lookahead");
+    std::filesystem::remove_all("resumed_lookahead");
+  }
+  run("straight_lookahead", 0.5, false, MPI_COMM_WORLD, lookahead);
+  run("resumed_lookahead", 0.25, false, MPI_COMM_WORLD, lookahead);
+  run("resumed_lookahead", 0.5, true, MPI_COMM_WORLD, lookahead);
 
   // A fresh run (Resume = false) where another run left its checkpoints
   // (steps 8 and 10): it must not take them for its own newest sets.
@@ -241,6 +262,30 @@ main(int argc, char **argv)
       changed |= straight_auto[r][cells] != straight_auto[r - 1][cells];
     std::cout << "mesh changed after the checkpoint: "
               << (changed ? "yes" : "no") << '\n';
+  }
+  {
+    std::cout << "Band lookahead = 1:\n";
+    const auto straight = read_csv_rows("straight_lookahead/statistics.csv");
+    compare(straight, read_csv_rows("resumed_lookahead/statistics.csv"));
+    // The adaptations after the checkpoint (the log says before which
+    // step each came; the resumed run's log goes on from the first part's).
+    const auto adaptations = [](const std::string &directory)
+    {
+      std::ifstream     in(directory + "/log.txt");
+      std::string       line, steps;
+      const std::string key = "mesh adapted before step ";
+      while (std::getline(in, line))
+        if (const auto at = line.find(key); at != std::string::npos)
+        {
+          const int step = std::atoi(line.c_str() + at + key.size());
+          if (step > 4)
+            steps += ' ' + std::to_string(step);
+        }
+      return steps;
+    };
+    std::cout << "adapted after the checkpoint, before steps:"
+              << adaptations("straight_lookahead")
+              << " (resumed:" << adaptations("resumed_lookahead") << ")\n";
   }
   {
     std::vector<std::string> sets;

@@ -113,6 +113,10 @@ namespace ImmersedGrains
      *  steps = auto with the grain band). */
     bool
     tracks_grain_travel() const;
+    /** Whether the grains follow their straight paths for a lookahead band
+     *  (Adaptivity/Band lookahead). */
+    bool
+    follows_straight_paths() const;
     void
     update_shortest_cell_edge();
     double
@@ -196,8 +200,10 @@ namespace ImmersedGrains
     // How far the fastest grain may have travelled since the last
     // adaptation (a sum of the largest speed over each step times the
     // step), and that speed at the start of the step being taken.
-    double grain_travel       = 0;
-    double step_start_speed   = 0;
+    double grain_travel     = 0;
+    double step_start_speed = 0;
+    // Band lookahead: when the band was last made.
+    double band_made_at       = 0;
     bool   warned_band_outrun = false;
     // The largest speed over the driven speed so far, and that speed then.
     double largest_speed_ratio = 0;

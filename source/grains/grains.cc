@@ -15,7 +15,8 @@ namespace ImmersedGrains
   template <int dim>
   GrainPropertyLayout
   make_grain_property_layout(const GrainParameters<dim> &prm,
-                             const bool                  with_fluid)
+                             const bool                  with_fluid,
+                             const bool                  straight_paths)
   {
     using namespace dealii::DataComponentInterpretation;
     GrainPropertyLayout l;
@@ -49,6 +50,11 @@ namespace ImmersedGrains
     }
     if (prm.has_fixed_region)
       l.fixed = add("fixed", 1, false);
+    if (straight_paths)
+    {
+      l.path_velocity  = add("path_velocity", dim, true);
+      l.path_deviation = add("path_deviation", dim, true);
+    }
     return l;
   }
 
@@ -59,13 +65,15 @@ namespace ImmersedGrains
     const Geometry<dim>                                     &geometry,
     const dealii::parallel::distributed::Triangulation<dim> &tria,
     const bool                                               with_fluid,
-    dealii::TimerOutput                                     &timer)
+    dealii::TimerOutput                                     &timer,
+    const bool                                               straight_paths)
       : parameters(parameters)
       , geometry(geometry)
       , triangulation(tria)
       , comm(tria.get_communicator())
       , timer(timer)
-      , properties(make_grain_property_layout(parameters, with_fluid))
+      , properties(
+          make_grain_property_layout(parameters, with_fluid, straight_paths))
       , particles(tria, mapping, properties.n_properties)
       , vertex_cache(tria, mapping)
   {
@@ -345,6 +353,7 @@ namespace ImmersedGrains
       if (properties.fixed != GrainPropertyLayout::absent)
         props[properties.fixed] = fixed ? 1 : 0;
     }
+    reset_straight_paths();
     AssertThrow(particles.n_global_particles() == seeds.size(),
                 dealii::ExcMessage(
                   "Grains: " +
@@ -707,12 +716,32 @@ namespace ImmersedGrains
     std::vector<particle_iterator> crossing;
     unsigned long                  n_fixed = 0, n_elsewhere = 0;
     unsigned int                   i = 0;
+    // With straight paths: the largest deviation and velocity change.
+    const bool paths = properties.path_deviation != GrainPropertyLayout::absent;
+    double     largest[2] = {0, 0};
     for (auto p = particles.begin(); p != particles.end(); ++p, ++i)
     {
       const bool         fixed = arrays.fixed[i];
       dealii::Point<dim> x     = arrays.position[i] + dt * c.velocity[i];
       if (!c.position_correction.empty())
         x += c.position_correction[i];
+      if (paths && !fixed)
+      {
+        auto                   props = p->get_properties();
+        dealii::Tensor<1, dim> v0, deviation;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          v0[d]        = props[properties.path_velocity + d];
+          deviation[d] = props[properties.path_deviation + d];
+        }
+        deviation += dt * (c.velocity[i] - v0);
+        if (!c.position_correction.empty())
+          deviation += c.position_correction[i];
+        for (unsigned int d = 0; d < dim; ++d)
+          props[properties.path_deviation + d] = deviation[d];
+        largest[0] = std::max(largest[0], deviation.norm());
+        largest[1] = std::max(largest[1], (c.velocity[i] - v0).norm());
+      }
       bool left = false;
       for (unsigned int d = 0; d < dim && !fixed; ++d)
       {
@@ -810,6 +839,14 @@ namespace ImmersedGrains
           taken_out.push_back(p);
       }
     }
+    if (paths)
+    {
+      dealii::Utilities::MPI::max(dealii::ArrayView<const double>(largest, 2),
+                                  comm,
+                                  dealii::ArrayView<double>(largest, 2));
+      drift = {largest[0], largest[1]};
+    }
+
     const unsigned long n_leaving = leaving.size();
     // Owned grains that stay, and the fixed ones among them, on all ranks.
     std::vector<unsigned long> before = {
@@ -864,6 +901,25 @@ namespace ImmersedGrains
       dealii::Utilities::MPI::sum<unsigned long>(n_leaving, comm);
     removed_total += removed;
     return removed;
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::reset_straight_paths()
+  {
+    if (properties.path_deviation == GrainPropertyLayout::absent)
+      return;
+    for (auto &p : particles)
+    {
+      auto props = p.get_properties();
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        props[properties.path_velocity + d]  = props[properties.velocity + d];
+        props[properties.path_deviation + d] = 0;
+      }
+    }
+    drift = StraightPathDrift();
   }
 
 
@@ -1005,9 +1061,9 @@ namespace ImmersedGrains
 
 
   template GrainPropertyLayout
-  make_grain_property_layout(const GrainParameters<2> &, bool);
+  make_grain_property_layout(const GrainParameters<2> &, bool, bool);
   template GrainPropertyLayout
-  make_grain_property_layout(const GrainParameters<3> &, bool);
+  make_grain_property_layout(const GrainParameters<3> &, bool, bool);
   template class Grains<2>;
   template class Grains<3>;
 } // namespace ImmersedGrains

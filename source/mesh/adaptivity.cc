@@ -11,6 +11,7 @@
 #include <immersed_grains/fluid/fluid_solver.h>
 #include <immersed_grains/grains/grain_parameters.h>
 #include <immersed_grains/mesh/adaptivity.h>
+#include <immersed_grains/mesh/geometry.h>
 #include <immersed_grains/parameters.h>
 
 #include <array>
@@ -128,8 +129,10 @@ namespace ImmersedGrains
         "cells) since the last adaptation, counting the step about to be "
         "taken: the grains stay inside the band whatever the time step, and "
         "the mesh is left alone while they are slow (with Criteria = "
-        "velocity, also every 5 steps). A number N: adapt before every N-th "
-        "fluid step (0: only before the first).");
+        "velocity, also every 5 steps). With Band lookahead, not before the "
+        "lookahead runs out or a grain may have strayed half the band from "
+        "its straight path. A number N: adapt before every N-th fluid step "
+        "(0: only before the first).");
       prm.declare_entry(
         "Criteria",
         "grains",
@@ -164,6 +167,20 @@ namespace ImmersedGrains
         "and the fine mesh stays on the cloud (doc/adaptivity.md). One grain "
         "of diameter d in a cell of edge h fills (pi/6)(d/h)^3 of it in 3D, "
         "(pi/4)(d/h)^2 in 2D.");
+      prm.declare_entry(
+        "Band lookahead",
+        "0",
+        Double(0, 64),
+        "Criteria = grains with Every steps = auto: the band also covers "
+        "each grain's straight path along its velocity, the fastest grain's "
+        "this many finest cells ahead (the others' as far as they go in the "
+        "same time), and the mesh is adapted again when that time is over "
+        "or a grain may have strayed half the band from its path (the "
+        "largest velocity changes, summed). Grains that move together (a "
+        "falling cloud) then cross several cells between adaptations "
+        "instead of one, for a band a few cells longer; one adaptation "
+        "refines the cells ahead in as many passes as they lack levels. "
+        "0: the band around the grains only (doc/adaptivity.md).");
       prm.declare_entry(
         "Minimum cell size",
         "2",
@@ -214,6 +231,7 @@ namespace ImmersedGrains
       coarsen_fraction   = prm.get_double("Coarsen fraction");
       min_cell_size      = prm.get_double("Minimum cell size");
       min_solid_fraction = prm.get_double("Minimum solid fraction");
+      band_lookahead     = prm.get_double("Band lookahead");
       if (enabled)
       {
         where.require(min_level <= max_level,
@@ -239,12 +257,75 @@ namespace ImmersedGrains
   template <int dim>
   Adaptivity<dim>::Adaptivity(
     const Parameters                                  &parameters,
+    const Geometry<dim>                               &geometry,
     dealii::parallel::distributed::Triangulation<dim> &tria,
     const double                                       smallest_cell)
       : parameters(parameters)
+      , geometry(geometry)
       , triangulation(tria)
       , smallest_cell(smallest_cell)
   {
+    // The coarse mesh is the box's Subdivisions (Geometry), whatever the
+    // order in which the triangulation holds its coarse cells.
+    unsigned int n = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      n *= geometry.subdivisions[d];
+    coarse.resize(n, triangulation.end());
+    for (const auto &cell : triangulation.cell_iterators_on_level(0))
+    {
+      const dealii::Point<dim> c = cell->center();
+      unsigned int             k = 0, stride = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double width =
+          (geometry.upper_corner[d] - geometry.lower_corner[d]) /
+          geometry.subdivisions[d];
+        k += stride * static_cast<unsigned int>(
+                        std::floor((c[d] - geometry.lower_corner[d]) / width));
+        stride *= geometry.subdivisions[d];
+      }
+      Assert(k < n && coarse[k] == triangulation.end(),
+             dealii::ExcInternalError());
+      coarse[k] = cell;
+    }
+  }
+
+
+  template <int dim>
+  typename dealii::Triangulation<dim>::active_cell_iterator
+  Adaptivity<dim>::active_cell_at(dealii::Point<dim> point) const
+  {
+    const auto  &lo = geometry.lower_corner;
+    const auto  &hi = geometry.upper_corner;
+    unsigned int k = 0, stride = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      const double length = hi[d] - lo[d];
+      if (geometry.is_periodic(d))
+        point[d] =
+          lo[d] +
+          std::fmod(std::fmod(point[d] - lo[d], length) + length, length);
+      else if (point[d] < lo[d] || point[d] > hi[d])
+        return triangulation.end();
+      const unsigned int n = geometry.subdivisions[d];
+      k += stride * std::min(n - 1,
+                             static_cast<unsigned int>(
+                               std::floor((point[d] - lo[d]) / length * n)));
+      stride *= n;
+    }
+    // Down the tree: a child's number has bit d set where it lies on the
+    // upper side along axis d (deal.II's numbering of a box's children).
+    typename dealii::Triangulation<dim>::cell_iterator cell = coarse[k];
+    while (cell->has_children())
+    {
+      const dealii::Point<dim> centre = cell->center();
+      unsigned int             child  = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        if (point[d] >= centre[d])
+          child |= 1u << d;
+      cell = cell->child(child);
+    }
+    return typename dealii::Triangulation<dim>::active_cell_iterator(cell);
   }
 
 
@@ -296,8 +377,11 @@ namespace ImmersedGrains
   std::vector<unsigned int>
   Adaptivity<dim>::grain_band(
     const dealii::Particles::ParticleHandler<dim> &grains,
-    const unsigned int                             radius_property) const
+    const GrainProperties                         &properties,
+    const double                                   shortest_edge,
+    const bool                                     new_horizon)
   {
+    const unsigned int radius_property = properties.radius;
     // One value per cell with ghosts: a DG0 field.
     dealii::DoFHandler<dim>   cells(triangulation);
     const dealii::FE_DGQ<dim> fe(0);
@@ -308,13 +392,92 @@ namespace ImmersedGrains
       cells.locally_owned_dofs(), relevant, triangulation.get_communicator());
 
     std::vector<dealii::types::global_dof_index> index(1);
+    // The grains that start the band: where they are and how they move.
+    const bool lookahead = parameters.band_lookahead > 0;
+    std::vector<std::pair<dealii::Point<dim>, dealii::Tensor<1, dim>>> paths;
+    double fastest = 0;
     for (const auto &cell : cells.active_cell_iterators())
       if (cell->is_locally_owned() && grains.n_particles_in_cell(cell) > 0 &&
           dense_enough(cell, grains, radius_property))
       {
         cell->get_dof_indices(index);
         marked[index[0]] = 1;
+        if (lookahead)
+          for (const auto &grain : grains.particles_in_cell(cell))
+          {
+            dealii::Tensor<1, dim> v;
+            for (unsigned int d = 0; d < dim; ++d)
+              v[d] = grain.get_properties()[properties.velocity + d];
+            paths.emplace_back(grain.get_location(), v);
+            fastest = std::max(fastest, v.norm());
+          }
       }
+
+    if (lookahead)
+    {
+      if (new_horizon)
+      {
+        fastest = dealii::Utilities::MPI::max(fastest,
+                                              triangulation.get_communicator());
+        horizon =
+          fastest > 0 ? parameters.band_lookahead * shortest_edge / fastest : 0;
+      }
+      // Each path is sampled every half finest cell; the cells of the
+      // samples join the grains' cells. Paths that leave this rank's cells
+      // go to every rank, which marks its own.
+      const auto mark_path = [&](const dealii::Point<dim>     &start,
+                                 const dealii::Tensor<1, dim> &reach)
+      {
+        const unsigned int n = static_cast<unsigned int>(
+          std::ceil(reach.norm() / (0.5 * shortest_edge)));
+        bool elsewhere = false;
+        for (unsigned int k = 1; k <= n; ++k)
+        {
+          const auto cell = active_cell_at(start + (k / double(n)) * reach);
+          if (cell == triangulation.end())
+            continue; // beyond a wall
+          if (!cell->is_locally_owned())
+          {
+            elsewhere = true;
+            continue;
+          }
+          typename dealii::DoFHandler<dim>::active_cell_iterator(&triangulation,
+                                                                 cell->level(),
+                                                                 cell->index(),
+                                                                 &cells)
+            ->get_dof_indices(index);
+          marked[index[0]] = 1;
+        }
+        return elsewhere;
+      };
+      std::vector<double> leaving;
+      for (const auto &[x, v] : paths)
+        if (mark_path(x, horizon * v))
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            leaving.push_back(x[d]);
+            leaving.push_back(horizon * v[d]);
+          }
+      const MPI_Comm comm = triangulation.get_communicator();
+      if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
+      {
+        const auto all = dealii::Utilities::MPI::all_gather(comm, leaving);
+        for (unsigned int rank = 0; rank < all.size(); ++rank)
+          if (rank != dealii::Utilities::MPI::this_mpi_process(comm))
+            for (std::size_t i = 0; i + 2 * dim <= all[rank].size();
+                 i += 2 * dim)
+            {
+              dealii::Point<dim>     x;
+              dealii::Tensor<1, dim> reach;
+              for (unsigned int d = 0; d < dim; ++d)
+              {
+                x[d]     = all[rank][i + 2 * d];
+                reach[d] = all[rank][i + 2 * d + 1];
+              }
+              mark_path(x, reach);
+            }
+      }
+    }
 
     // Whether a cell (of the triangulation or of `cells`) is in the band.
     std::vector<dealii::types::global_dof_index> other_index(1);
@@ -411,8 +574,10 @@ namespace ImmersedGrains
   bool
   Adaptivity<dim>::mark_cells(
     const dealii::Particles::ParticleHandler<dim> *grains,
-    const unsigned int                             radius_property,
-    const FluidSolver<dim>                        *fluid)
+    const GrainProperties                         &properties,
+    const FluidSolver<dim>                        *fluid,
+    const double                                   shortest_edge,
+    const bool                                     refine_only)
   {
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())
@@ -421,7 +586,7 @@ namespace ImmersedGrains
         cell->clear_coarsen_flag();
       }
 
-    if (parameters.velocity_kelly && fluid != nullptr)
+    if (parameters.velocity_kelly && fluid != nullptr && !refine_only)
     {
       dealii::Vector<float> indicators(triangulation.n_active_cells());
       const dealii::FEValuesExtractors::Vector velocities(0);
@@ -444,7 +609,7 @@ namespace ImmersedGrains
 
     std::vector<unsigned int> band;
     if (parameters.around_grains && grains != nullptr)
-      band = grain_band(*grains, radius_property);
+      band = grain_band(*grains, properties, shortest_edge, !refine_only);
 
     for (const auto &cell : triangulation.active_cell_iterators())
     {
@@ -456,6 +621,14 @@ namespace ImmersedGrains
       const bool in_band =
         distance > 0 && distance <= parameters.band_width + 1;
       const bool beside_band = distance == parameters.band_width + 2;
+      if (refine_only)
+      {
+        // Only what the band still lacks (the levels' limits as below).
+        if (in_band && level < parameters.max_level &&
+            cell->minimum_vertex_distance() >= 2 * smallest_cell)
+          cell->set_refine_flag();
+        continue;
+      }
       if (in_band)
       {
         cell->clear_coarsen_flag();

@@ -43,7 +43,12 @@ namespace ImmersedGrains
     unsigned int contact_impulse   = absent;
     unsigned int predicted_impulse = absent;
     unsigned int fixed             = absent;
-    unsigned int n_properties      = 0;
+    /** Adaptivity/Band lookahead: the velocity each grain had when the
+     *  band was made, and how far it has strayed since from the straight
+     *  line along it (a vector). */
+    unsigned int path_velocity  = absent;
+    unsigned int path_deviation = absent;
+    unsigned int n_properties   = 0;
 
     /** Names and interpretations per component, for particle output. */
     std::vector<std::string> names;
@@ -53,11 +58,13 @@ namespace ImmersedGrains
   };
 
   /** The layout a scene's grains get from its parameters: with a fluid
-   *  (@p with_fluid), friction, contacts and a fixed region. */
+   *  (@p with_fluid), friction, contacts, a fixed region and straight
+   *  paths (@p straight_paths, for a lookahead band). */
   template <int dim>
   GrainPropertyLayout
   make_grain_property_layout(const GrainParameters<dim> &parameters,
-                             bool                        with_fluid);
+                             bool                        with_fluid,
+                             bool straight_paths = false);
 
   /**
    * The arrays of one step, gathered once from the ParticleHandler in its
@@ -127,6 +134,19 @@ namespace ImmersedGrains
     dealii::Point<dim> fixed_centroid;
   };
 
+  /**
+   * How far the grains have strayed from the straight lines x_0 + v_0 t
+   * their velocities pointed along when their paths were last reset (the
+   * mesh's lookahead band covers those lines, Adaptivity): the largest
+   * |x - x_0 - v_0 t| and the largest |v - v_0| of any grain, after the
+   * last move. Global: every rank holds the same values.
+   */
+  struct StraightPathDrift
+  {
+    double displacement = 0; // m
+    double velocity     = 0; // m/s
+  };
+
   /** What one grain step did (global numbers). */
   struct GrainStepReport
   {
@@ -157,11 +177,14 @@ namespace ImmersedGrains
   class Grains
   {
   public:
+    /** @p straight_paths: each grain follows its deviation from a
+     *  straight path (straight_path_drift()). */
     Grains(const GrainParameters<dim>                              &parameters,
            const Geometry<dim>                                     &geometry,
            const dealii::parallel::distributed::Triangulation<dim> &tria,
            bool                                                     with_fluid,
-           dealii::TimerOutput                                     &timer);
+           dealii::TimerOutput                                     &timer,
+           bool straight_paths = false);
 
     /** Inserts the initial grains (the same list on every rank); grain k
      *  gets particle id k. */
@@ -216,10 +239,25 @@ namespace ImmersedGrains
     GrainStepReport
     resolve_contacts(double dt, bool add_to_step_impulse = false);
 
-    /** x += dt v, removes/wraps, writes back and sorts into cells. Returns
-     *  the number of grains removed on all ranks. */
+    /** x += dt v, removes/wraps, writes back and sorts into cells (with
+     *  straight paths: adds the step to each grain's deviation, and
+     *  updates straight_path_drift()). Returns the number of grains
+     *  removed on all ranks. */
     unsigned long
     move_and_scatter(double dt);
+
+    /** With straight paths: each grain's path starts anew where it is,
+     *  along its velocity now. */
+    void
+    reset_straight_paths();
+
+    /** With straight paths: since the last reset_straight_paths(). (A
+     *  resumed run sets what it saved.) */
+    StraightPathDrift &
+    straight_path_drift()
+    {
+      return drift;
+    }
 
     GrainStepArrays<dim> &
     step_arrays();
@@ -305,6 +343,7 @@ namespace ImmersedGrains
 
     GrainStepArrays<dim> arrays;
     unsigned long        removed_total = 0;
+    StraightPathDrift    drift;
 
     /** The other ranks' cells near each owned cell (update_partition()). */
     typename DistributedContacts<dim>::PartitionHalo

@@ -6,11 +6,14 @@
 #include <deal.II/particles/particle_handler.h>
 
 #include <string>
+#include <vector>
 
 namespace ImmersedGrains
 {
   template <int dim>
   class FluidSolver;
+  template <int dim>
+  class Geometry;
 
   /**
    * Where the mesh is refined and coarsened (subsection Adaptivity): cells
@@ -50,23 +53,59 @@ namespace ImmersedGrains
       /** Solid fraction a Max-level cell's volume must hold for the grains
        *  in it to start the band (0: any grain). */
       double min_solid_fraction = 0;
+      /** Band lookahead: how many finest cells the band reaches ahead of
+       *  the fastest grain along its velocity (0: no lookahead). */
+      double band_lookahead = 0;
     };
 
     /** @p smallest_cell: no cell is refined into children smaller than
      *  this (Minimum cell size times the largest grain diameter). */
     Adaptivity(const Parameters                                  &parameters,
+               const Geometry<dim>                               &geometry,
                dealii::parallel::distributed::Triangulation<dim> &tria,
                double smallest_cell);
+
+    /** Where the grains' properties lie (GrainPropertyLayout). */
+    struct GrainProperties
+    {
+      unsigned int radius   = 0;
+      unsigned int velocity = 0;
+    };
 
     /**
      * Sets refine and coarsen flags on the locally owned cells and lets
      * the triangulation smooth them (prepare_coarsening_and_refinement()).
-     * Returns whether any cell anywhere is flagged (collective).
+     * Returns whether any cell anywhere is flagged (collective). With
+     * @p refine_only only the band's cells below Max level are flagged
+     * (the further passes of one adaptation: a cell climbs one level per
+     * pass, and the lookahead band reaches cells several levels coarser).
+     * Without it the lookahead horizon is set anew from the grains'
+     * velocities and @p shortest_edge, the mesh's shortest cell edge.
      */
     bool
     mark_cells(const dealii::Particles::ParticleHandler<dim> *grains,
-               unsigned int                                   radius_property,
-               const FluidSolver<dim>                        *fluid);
+               const GrainProperties                         &properties,
+               const FluidSolver<dim>                        *fluid,
+               double                                         shortest_edge,
+               bool refine_only = false);
+
+    /**
+     * Band lookahead > 0: for how long after the last marking every
+     * grain that starts the band is covered along its straight path
+     * x_0 + v_0 t (the band holds it as long as it strays from that line
+     * by less than travel_allowance()). 0 without lookahead, or where
+     * the grains were at rest. Saved with a checkpoint.
+     */
+    double
+    lookahead_horizon() const
+    {
+      return horizon;
+    }
+    void
+    set_lookahead_horizon(const double t)
+    {
+      horizon = t;
+    }
 
     /**
      * Whether the mesh should change before step @p step, when the grains
@@ -99,7 +138,14 @@ namespace ImmersedGrains
      *  partition. */
     std::vector<unsigned int>
     grain_band(const dealii::Particles::ParticleHandler<dim> &grains,
-               unsigned int radius_property) const;
+               const GrainProperties                         &properties,
+               double                                         shortest_edge,
+               bool                                           new_horizon);
+
+    /** The active cell (owned, ghost or artificial) holding @p point in
+     *  the box, periodic faces wrapped; the end iterator outside. */
+    typename dealii::Triangulation<dim>::active_cell_iterator
+    active_cell_at(dealii::Point<dim> point) const;
 
     /** Whether the grains in @p cell fill at least Minimum solid fraction of
      *  the volume of some cell of the finest size the cell can be refined
@@ -111,8 +157,12 @@ namespace ImmersedGrains
       unsigned int radius_property) const;
 
     const Parameters                                  &parameters;
+    const Geometry<dim>                               &geometry;
     dealii::parallel::distributed::Triangulation<dim> &triangulation;
     const double                                       smallest_cell;
+    double                                             horizon = 0;
+    /// The coarse cells (level 0) in the box's lexicographic order.
+    std::vector<typename dealii::Triangulation<dim>::cell_iterator> coarse;
   };
 } // namespace ImmersedGrains
 
