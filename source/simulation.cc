@@ -761,8 +761,14 @@ namespace ImmersedGrains
                      drift.displacement + next_time_step() * drift.velocity);
         }
         // (Band width = 0 asks for no margin: nothing to warn about.)
+        // (Along its path the lookahead covers a grain too.)
+        const double covered =
+          2 * adaptivity->travel_allowance(shortest_cell_edge) +
+          (follows_straight_paths() ?
+             adaptivity_parameters.band_lookahead * shortest_cell_edge :
+             0.0);
         if (!warned_band_outrun && adaptivity_parameters.band_width > 0 &&
-            ahead > 2 * adaptivity->travel_allowance(shortest_cell_edge))
+            ahead > covered)
         {
           warned_band_outrun = true;
           pcout << "  warning: step " << step + 1
@@ -770,8 +776,11 @@ namespace ImmersedGrains
                 << ahead / shortest_cell_edge
                 << " of the finest cells in one fluid step, more than the "
                    "band around the grains (Adaptivity/Band width = "
-                << adaptivity_parameters.band_width
-                << "): grains leave the refined cells between adaptations; "
+                << adaptivity_parameters.band_width;
+          if (follows_straight_paths())
+            pcout << ", Band lookahead = "
+                  << adaptivity_parameters.band_lookahead;
+          pcout << "): grains leave the refined cells between adaptations; "
                    "widen the band or shorten the step (Courant number, Time "
                    "step)\n"
                 << std::setprecision(6);

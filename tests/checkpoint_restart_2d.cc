@@ -109,8 +109,10 @@ main(int argc, char **argv)
   // level 5) the grains (0.3 mm/s, 17 um per step) call for one every 3
   // steps, so the resumed run must pick up the sum of the steps before the
   // checkpoint.
+  // (The band without lookahead, whose schedule is that sum alone.)
   const std::string by_travel = "subsection Adaptivity\n  set Every steps = "
-                                "auto\n  set Max level = 5\nend\n";
+                                "auto\n  set Max level = 5\n  set Band "
+                                "lookahead = 0\nend\n";
   if (root)
   {
     std::filesystem::remove_all("straight_auto");
@@ -120,15 +122,15 @@ main(int argc, char **argv)
   run("resumed_auto", 0.25, false, MPI_COMM_WORLD, by_travel);
   run("resumed_auto", 0.5, true, MPI_COMM_WORLD, by_travel);
 
-  // With Band lookahead = 1 the band made before step 4 (the grains start
-  // at rest, so the first is made by their travel) covers one cell (4
-  // steps) of each grain's path. The schedule then depends on when the
-  // band was made and on each grain's deviation from its path (grain
-  // properties): the resumed run must carry both across the checkpoint of
-  // step 4 to adapt again before step 7, as the straight run does.
+  // With Band lookahead = 1 (and Band width 2) the band made before step 4 (the
+  // grains start at rest, so the first is made by their travel) covers one cell
+  // (4 steps) of each grain's path. The schedule then depends on when the band
+  // was made and on each grain's deviation from its path (grain properties):
+  // the resumed run must carry both across the checkpoint of step 4 to adapt
+  // again before step 7, as the straight run does.
   const std::string lookahead = "subsection Adaptivity\n  set Every steps = "
                                 "auto\n  set Max level = 5\n  set Band "
-                                "lookahead = 1\nend\n";
+                                "lookahead = 1\n  set Band width = 2\nend\n";
   if (root)
   {
     std::filesystem::remove_all("straight_lookahead");

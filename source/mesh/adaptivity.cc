@@ -142,11 +142,17 @@ namespace ImmersedGrains
         "velocity: the Kelly estimator of the fluid velocity refines "
         "Refine fraction and coarsens Coarsen fraction of the cells (by "
         "number) between the two levels, for wakes.");
-      prm.declare_entry("Band width",
-                        "2",
-                        Integer(0, 20),
-                        "Layers of cells (sharing a vertex) around the cells "
-                        "that hold grains that are refined with them.");
+      prm.declare_entry(
+        "Band width",
+        "auto",
+        Anything(),
+        "Layers of cells (sharing a vertex) around the cells that hold "
+        "grains (and their paths, with Band lookahead) that are refined with "
+        "them, 0 to 20. auto: 1 where the band looks ahead along the grains' "
+        "paths (Band lookahead > 0 with Every steps = auto and Criteria = "
+        "grains: the path gives the band its length where the grains go, "
+        "and one layer is the margin for their deviation from it), 2 "
+        "otherwise.");
       prm.declare_entry("Refine fraction",
                         "0.1",
                         Double(0, 1),
@@ -169,7 +175,7 @@ namespace ImmersedGrains
         "(pi/4)(d/h)^2 in 2D.");
       prm.declare_entry(
         "Band lookahead",
-        "0",
+        "2",
         Double(0, 64),
         "Criteria = grains with Every steps = auto: the band also covers "
         "each grain's straight path along its velocity, the fastest grain's "
@@ -180,7 +186,10 @@ namespace ImmersedGrains
         "falling cloud) then cross several cells between adaptations "
         "instead of one, for a band a few cells longer; one adaptation "
         "refines the cells ahead in as many passes as they lack levels. "
-        "0: the band around the grains only (doc/adaptivity.md).");
+        "0: the band around the grains only (doc/adaptivity.md). The "
+        "default, with Band width = auto (1), was measured on the falling "
+        "clouds: 20-40 % less wall time than the band of 2 layers without "
+        "it, the clouds within a few micrometres of where they were.");
       prm.declare_entry(
         "Minimum cell size",
         "2",
@@ -226,12 +235,27 @@ namespace ImmersedGrains
       velocity_kelly =
         std::find(criteria.begin(), criteria.end(), "velocity") !=
         criteria.end();
-      band_width         = prm.get_integer("Band width");
-      refine_fraction    = prm.get_double("Refine fraction");
-      coarsen_fraction   = prm.get_double("Coarsen fraction");
-      min_cell_size      = prm.get_double("Minimum cell size");
-      min_solid_fraction = prm.get_double("Minimum solid fraction");
-      band_lookahead     = prm.get_double("Band lookahead");
+      refine_fraction         = prm.get_double("Refine fraction");
+      coarsen_fraction        = prm.get_double("Coarsen fraction");
+      min_cell_size           = prm.get_double("Minimum cell size");
+      min_solid_fraction      = prm.get_double("Minimum solid fraction");
+      band_lookahead          = prm.get_double("Band lookahead");
+      const std::string width = prm.get("Band width");
+      if (width == "auto")
+        band_width =
+          band_lookahead > 0 && follow_grains && around_grains ? 1 : 2;
+      else
+      {
+        char      *end   = nullptr;
+        const long value = std::strtol(width.c_str(), &end, 10);
+        where.require(!width.empty() && end != nullptr && *end == '\0' &&
+                        value >= 0 && value <= 20,
+                      "Band width",
+                      width,
+                      "is neither auto nor a number of cell layers from 0 "
+                      "to 20");
+        band_width = static_cast<unsigned int>(value);
+      }
       if (enabled)
       {
         where.require(min_level <= max_level,
