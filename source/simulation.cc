@@ -642,9 +642,7 @@ namespace ImmersedGrains
   {
     // (Before the grains and the adaptivity exist: from the parameters.)
     return adaptivity_parameters.enabled && grain_parameters.enabled &&
-           fluid_parameters.enabled && adaptivity_parameters.follow_grains &&
-           adaptivity_parameters.around_grains &&
-           adaptivity_parameters.band_lookahead > 0;
+           fluid_parameters.enabled && adaptivity_parameters.looks_ahead();
   }
 
 
@@ -688,7 +686,7 @@ namespace ImmersedGrains
     // The lookahead band reaches cells several levels coarser than its
     // own: they climb a level per pass.
     unsigned int passes = 1;
-    if (adaptivity_parameters.band_lookahead > 0)
+    if (adaptivity_parameters.looks_ahead())
       for (; passes <= adaptivity_parameters.max_level && mark(true); ++passes)
         change_mesh([this]()
                     { triangulation.execute_coarsening_and_refinement(); });

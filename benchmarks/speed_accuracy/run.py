@@ -47,8 +47,15 @@ STRATEGIES = {
                   [("", "Courant number", 0.025),
                    ("Adaptivity", "Max level", 5),
                    ("Fluid/Linear solver", "Tolerance", 1e-8)]),
-    "default": ("the scene as shipped (Courant 0.1, Max level 4, BDF2, "
-                "extrapolated advection, tolerance 1e-6)", []),
+    "default": ("the scene as shipped (Courant 0.1, Max level 4, band of "
+                "one layer looking 2 cells ahead, BDF2, extrapolated "
+                "advection, tolerance 1e-6)", []),
+    "band_2": ("Adaptivity/Band lookahead 0, Band width 2 (the band without "
+               "lookahead)",
+               [("Adaptivity", "Band lookahead", 0),
+                ("Adaptivity", "Band width", 2)]),
+    "lookahead_4": ("Adaptivity/Band lookahead 4",
+                    [("Adaptivity", "Band lookahead", 4)]),
     "courant_0.5": ("Courant number 0.5", [("", "Courant number", 0.5)]),
     "courant_0.25": ("Courant number 0.25", [("", "Courant number", 0.25)]),
     "courant_0.05": ("Courant number 0.05", [("", "Courant number", 0.05)]),

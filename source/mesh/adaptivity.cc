@@ -181,8 +181,8 @@ namespace ImmersedGrains
         "each grain's straight path along its velocity, the fastest grain's "
         "this many finest cells ahead (the others' as far as they go in the "
         "same time), and the mesh is adapted again when that time is over "
-        "or a grain may have strayed half the band from its path (the "
-        "largest velocity changes, summed). Grains that move together (a "
+        "or a grain may have strayed half the band from its path (each "
+        "grain carries its deviation). Grains that move together (a "
         "falling cloud) then cross several cells between adaptations "
         "instead of one, for a band a few cells longer; one adaptation "
         "refines the cells ahead in as many passes as they lack levels. "
@@ -242,8 +242,7 @@ namespace ImmersedGrains
       band_lookahead          = prm.get_double("Band lookahead");
       const std::string width = prm.get("Band width");
       if (width == "auto")
-        band_width =
-          band_lookahead > 0 && follow_grains && around_grains ? 1 : 2;
+        band_width = looks_ahead() ? 1 : 2;
       else
       {
         char      *end   = nullptr;
@@ -417,7 +416,7 @@ namespace ImmersedGrains
 
     std::vector<dealii::types::global_dof_index> index(1);
     // The grains that start the band: where they are and how they move.
-    const bool lookahead = parameters.band_lookahead > 0;
+    const bool lookahead = parameters.looks_ahead();
     std::vector<std::pair<dealii::Point<dim>, dealii::Tensor<1, dim>>> paths;
     double fastest = 0;
     for (const auto &cell : cells.active_cell_iterators())

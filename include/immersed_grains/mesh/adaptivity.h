@@ -56,6 +56,14 @@ namespace ImmersedGrains
       /** Band lookahead: how many finest cells the band reaches ahead of
        *  the fastest grain along its velocity (0: no lookahead). */
       double band_lookahead = 0;
+
+      /** Whether the band looks ahead: Band lookahead > 0 where the mesh
+       *  follows the grains (Criteria = grains, Every steps = auto). */
+      bool
+      looks_ahead() const
+      {
+        return band_lookahead > 0 && follow_grains && around_grains;
+      }
     };
 
     /** @p smallest_cell: no cell is refined into children smaller than
