@@ -895,11 +895,26 @@ namespace ImmersedGrains
   void
   Simulation<dim>::check_saved_physics(const std::string &directory) const
   {
-    // Checkpoints written before this file existed are taken as they are.
+    // Checkpoints written before this file existed are taken as they are,
+    // unless the grains now follow straight paths, which no grain of such
+    // a set carries (Band lookahead came after the file).
     std::ifstream in(directory + "/physics.txt");
     std::string   saved;
     if (!std::getline(in, saved))
+    {
+      if (follows_straight_paths())
+        InputLocation{parameter_file, "Checkpoint"}.fail(
+          "Resume",
+          checkpoint_parameters.resume == Checkpoint::Resume::always ? "true" :
+                                                                       "auto",
+          directory +
+            " was written before the grains carried their straight paths "
+            "(it has no physics.txt), which Adaptivity/Band lookahead = " +
+            std::to_string(adaptivity_parameters.band_lookahead) +
+            " needs: resume with Band lookahead = 0, or start afresh with "
+            "Resume = false");
       return;
+    }
     const std::string wanted = saved_physics_description();
     if (saved != wanted)
       InputLocation{parameter_file, "Checkpoint"}.fail(

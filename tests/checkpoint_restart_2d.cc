@@ -18,7 +18,9 @@
 // deviation from its straight path. Last, a fresh run in a
 // directory that holds another run's checkpoints keeps only its own, and
 // a resume with other physics (friction added) stops with an input error
-// that names Checkpoint/Resume and leaves the run as it was.
+// that names Checkpoint/Resume and leaves the run as it was, and so does a
+// resume with the band's lookahead from sets written before physics.txt
+// (the same sets with the file taken away).
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 
@@ -102,6 +104,34 @@ main(int argc, char **argv)
   catch (const InputError &e)
   {
     friction_error = e.what();
+  }
+
+  // Sets written before physics.txt existed are resumed without the check,
+  // but never with the band's lookahead: their grains carry no straight
+  // paths. (The same run's sets with the file taken away.)
+  std::string unlabelled_error;
+  if (root)
+  {
+    std::filesystem::remove_all("unlabelled");
+    std::filesystem::copy("resumed",
+                          "unlabelled",
+                          std::filesystem::copy_options::recursive);
+    for (const auto &set :
+         std::filesystem::directory_iterator("unlabelled/checkpoints"))
+      std::filesystem::remove(set.path() / "physics.txt");
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  try
+  {
+    run("unlabelled",
+        0.75,
+        true,
+        MPI_COMM_WORLD,
+        "subsection Adaptivity\n  set Every steps = auto\nend\n");
+  }
+  catch (const InputError &e)
+  {
+    unlabelled_error = e.what();
   }
 
   // Every steps = auto adapts by how far the grains went since the last
@@ -213,6 +243,12 @@ main(int argc, char **argv)
                   "no")
             << ", before writing to the run's log: "
             << (log_size("resumed") == log_before ? "yes" : "no") << '\n';
+  std::cout << "a set without physics.txt resumed with the band's lookahead "
+               "stops with an input error naming Band lookahead: "
+            << (unlabelled_error.find("Band lookahead") != std::string::npos ?
+                  "yes" :
+                  "no")
+            << '\n';
 
   std::ifstream log("resumed/log.txt");
   std::string   text((std::istreambuf_iterator<char>(log)),
