@@ -744,22 +744,23 @@ namespace ImmersedGrains
         // grains until its end. (The last step's statistics hold the
         // grains' largest speed, reduced over the ranks; a checkpoint
         // carries it.)
-        step_start_speed   = statistics.get("max_speed");
-        const double ahead = step_start_speed * next_time_step();
-        reach              = grain_travel + ahead;
+        // (next_time_step() reduces over the grains and the fluid: once.)
+        const double dt_next = next_time_step();
+        step_start_speed     = statistics.get("max_speed");
+        const double ahead   = step_start_speed * dt_next;
+        reach                = grain_travel + ahead;
         // Within the lookahead the band holds every grain that strays
         // from its straight path by less than the allowance, however far
         // it went along it.
         const double horizon = adaptivity->lookahead_horizon();
-        if (horizon > 0 && time + next_time_step() - band_made_at <= horizon)
+        if (horizon > 0 && time + dt_next - band_made_at <= horizon)
         {
           const auto &drift = grains->straight_path_drift();
           reach =
-            std::min(reach,
-                     drift.displacement + next_time_step() * drift.velocity);
+            std::min(reach, drift.displacement + dt_next * drift.velocity);
         }
-        // (Band width = 0 asks for no margin: nothing to warn about.)
-        // (Along its path the lookahead covers a grain too.)
+        // Along its path the lookahead covers a grain too. (Band width = 0
+        // asks for no margin: nothing to warn about.)
         const double covered =
           2 * adaptivity->travel_allowance(shortest_cell_edge) +
           (follows_straight_paths() ?

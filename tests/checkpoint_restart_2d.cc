@@ -134,41 +134,42 @@ main(int argc, char **argv)
     unlabelled_error = e.what();
   }
 
+  // A run straight to step 10, and one stopped after step 5 and resumed
+  // from its checkpoint of step 4, with the Adaptivity section @p text.
+  const auto straight_and_resumed =
+    [&](const std::string &name, const std::string &text)
+  {
+    if (root)
+    {
+      std::filesystem::remove_all("straight_" + name);
+      std::filesystem::remove_all("resumed_" + name);
+    }
+    run("straight_" + name, 0.5, false, MPI_COMM_WORLD, text);
+    run("resumed_" + name, 0.25, false, MPI_COMM_WORLD, text);
+    run("resumed_" + name, 0.5, true, MPI_COMM_WORLD, text);
+  };
+
   // Every steps = auto adapts by how far the grains went since the last
   // adaptation, a sum the checkpoint carries: on cells of 62.5 um (Max
   // level 5) the grains (0.3 mm/s, 17 um per step) call for one every 3
   // steps, so the resumed run must pick up the sum of the steps before the
-  // checkpoint.
-  // (The band without lookahead, whose schedule is that sum alone.)
-  const std::string by_travel = "subsection Adaptivity\n  set Every steps = "
-                                "auto\n  set Max level = 5\n  set Band "
-                                "lookahead = 0\nend\n";
-  if (root)
-  {
-    std::filesystem::remove_all("straight_auto");
-    std::filesystem::remove_all("resumed_auto");
-  }
-  run("straight_auto", 0.5, false, MPI_COMM_WORLD, by_travel);
-  run("resumed_auto", 0.25, false, MPI_COMM_WORLD, by_travel);
-  run("resumed_auto", 0.5, true, MPI_COMM_WORLD, by_travel);
+  // checkpoint. (The band without lookahead, whose schedule is that sum
+  // alone.)
+  straight_and_resumed("auto",
+                       "subsection Adaptivity\n  set Every steps = auto\n"
+                       "  set Max level = 5\n  set Band lookahead = 0\nend\n");
 
-  // With Band lookahead = 1 (and Band width 2) the band made before step 4 (the
-  // grains start at rest, so the first is made by their travel) covers one cell
-  // (4 steps) of each grain's path. The schedule then depends on when the band
-  // was made and on each grain's deviation from its path (grain properties):
-  // the resumed run must carry both across the checkpoint of step 4 to adapt
-  // again before step 7, as the straight run does.
-  const std::string lookahead = "subsection Adaptivity\n  set Every steps = "
-                                "auto\n  set Max level = 5\n  set Band "
-                                "lookahead = 1\n  set Band width = 2\nend\n";
-  if (root)
-  {
-    std::filesystem::remove_all("straight_lookahead");
-    std::filesystem::remove_all("resumed_lookahead");
-  }
-  run("straight_lookahead", 0.5, false, MPI_COMM_WORLD, lookahead);
-  run("resumed_lookahead", 0.25, false, MPI_COMM_WORLD, lookahead);
-  run("resumed_lookahead", 0.5, true, MPI_COMM_WORLD, lookahead);
+  // With Band lookahead = 1 (and Band width 2) the band made before step 4
+  // (the grains start at rest, so the first is made by their travel)
+  // covers one cell (4 steps) of each grain's path. The schedule then
+  // depends on when the band was made and on each grain's deviation from
+  // its path (grain properties): the resumed run must carry both across
+  // the checkpoint of step 4 to adapt again before step 7, as the straight
+  // run does.
+  straight_and_resumed("lookahead",
+                       "subsection Adaptivity\n  set Every steps = auto\n"
+                       "  set Max level = 5\n  set Band lookahead = 1\n"
+                       "  set Band width = 2\nend\n");
 
   // A fresh run (Resume = false) where another run left its checkpoints
   // (steps 8 and 10): it must not take them for its own newest sets.

@@ -748,10 +748,7 @@ namespace ImmersedGrains
         const double L = hi[d] - lo[d];
         if (geometry.is_periodic(d))
         {
-          // Wrap into [lo, hi).
-          x[d] = lo[d] + std::fmod(std::fmod(x[d] - lo[d], L) + L, L);
-          if (x[d] >= hi[d])
-            x[d] = lo[d];
+          x[d] = geometry.wrap(d, x[d]);
           continue;
         }
         for (unsigned int side = 0; side < 2; ++side)

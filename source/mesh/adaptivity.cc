@@ -212,22 +212,32 @@ namespace ImmersedGrains
     const InputLocation where{file, "Adaptivity"};
     prm.enter_subsection("Adaptivity");
     {
-      enabled                 = prm.get_bool("Enabled");
-      min_level               = prm.get_integer("Min level");
-      max_level               = prm.get_integer("Max level");
-      const std::string every = prm.get("Every steps");
-      follow_grains           = every == "auto";
-      if (!follow_grains)
+      enabled   = prm.get_bool("Enabled");
+      min_level = prm.get_integer("Min level");
+      max_level = prm.get_integer("Max level");
+      // "auto" or a whole number from 0 to @p largest (then in @p value).
+      const auto auto_or_count = [&](const std::string &entry,
+                                     const unsigned int largest,
+                                     const std::string &what,
+                                     unsigned int      &value)
       {
-        char      *end   = nullptr;
-        const long value = std::strtol(every.c_str(), &end, 10);
-        const bool whole = !every.empty() && end != nullptr && *end == '\0';
-        where.require(whole && value >= 0,
-                      "Every steps",
-                      every,
-                      "is neither auto nor a number of steps (0 or more)");
-        every_steps = static_cast<unsigned int>(value);
-      }
+        const std::string text = prm.get(entry);
+        if (text == "auto")
+          return true;
+        char      *end    = nullptr;
+        const long number = std::strtol(text.c_str(), &end, 10);
+        where.require(!text.empty() && end != nullptr && *end == '\0' &&
+                        number >= 0 && number <= static_cast<long>(largest),
+                      entry,
+                      text,
+                      "is neither auto nor " + what);
+        value = static_cast<unsigned int>(number);
+        return false;
+      };
+      follow_grains = auto_or_count("Every steps",
+                                    std::numeric_limits<int>::max(),
+                                    "a number of steps (0 or more)",
+                                    every_steps);
       const auto criteria =
         dealii::Utilities::split_string_list(prm.get("Criteria"));
       around_grains =
@@ -235,26 +245,16 @@ namespace ImmersedGrains
       velocity_kelly =
         std::find(criteria.begin(), criteria.end(), "velocity") !=
         criteria.end();
-      refine_fraction         = prm.get_double("Refine fraction");
-      coarsen_fraction        = prm.get_double("Coarsen fraction");
-      min_cell_size           = prm.get_double("Minimum cell size");
-      min_solid_fraction      = prm.get_double("Minimum solid fraction");
-      band_lookahead          = prm.get_double("Band lookahead");
-      const std::string width = prm.get("Band width");
-      if (width == "auto")
+      refine_fraction    = prm.get_double("Refine fraction");
+      coarsen_fraction   = prm.get_double("Coarsen fraction");
+      min_cell_size      = prm.get_double("Minimum cell size");
+      min_solid_fraction = prm.get_double("Minimum solid fraction");
+      band_lookahead     = prm.get_double("Band lookahead");
+      if (auto_or_count("Band width",
+                        20,
+                        "a number of cell layers from 0 to 20",
+                        band_width))
         band_width = looks_ahead() ? 1 : 2;
-      else
-      {
-        char      *end   = nullptr;
-        const long value = std::strtol(width.c_str(), &end, 10);
-        where.require(!width.empty() && end != nullptr && *end == '\0' &&
-                        value >= 0 && value <= 20,
-                      "Band width",
-                      width,
-                      "is neither auto nor a number of cell layers from 0 "
-                      "to 20");
-        band_width = static_cast<unsigned int>(value);
-      }
       if (enabled)
       {
         where.require(min_level <= max_level,
@@ -325,9 +325,7 @@ namespace ImmersedGrains
     {
       const double length = hi[d] - lo[d];
       if (geometry.is_periodic(d))
-        point[d] =
-          lo[d] +
-          std::fmod(std::fmod(point[d] - lo[d], length) + length, length);
+        point[d] = geometry.wrap(d, point[d]);
       else if (point[d] < lo[d] || point[d] > hi[d])
         return triangulation.end();
       const unsigned int n = geometry.subdivisions[d];

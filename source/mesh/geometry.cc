@@ -154,6 +154,18 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  double
+  Geometry<dim>::wrap(const unsigned int direction, const double x) const
+  {
+    const double lo = lower_corner[direction], hi = upper_corner[direction];
+    const double L = hi - lo;
+    const double y = lo + std::fmod(std::fmod(x - lo, L) + L, L);
+    // (Round-off can land on the upper face itself.)
+    return y >= hi ? lo : y;
+  }
+
+
+  template <int dim>
   bool
   Geometry<dim>::has_open_boundary() const
   {

@@ -53,6 +53,11 @@ namespace ImmersedGrains
     bool
     is_periodic(unsigned int direction) const;
 
+    /** @p x moved by whole periods into [lower, upper) along the
+     *  periodic @p direction. */
+    double
+    wrap(unsigned int direction, double x) const;
+
     bool
     has_open_boundary() const;
 
