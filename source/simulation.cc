@@ -401,6 +401,16 @@ namespace ImmersedGrains
       band.band_width = adaptivity_parameters.band_width;
       band.smallest_cell =
         adaptivity_parameters.min_cell_size * 2 * largest_grain_radius;
+      if (adaptivity_parameters.looks_ahead())
+      {
+        band.lookahead = adaptivity_parameters.band_lookahead;
+        // Gravity's main axis: where the grains go is not known before
+        // they move, and most scenes' grains settle or rise.
+        for (unsigned int d = 1; d < dim; ++d)
+          if (std::abs(grain_parameters.gravity[d]) >
+              std::abs(grain_parameters.gravity[band.path_axis]))
+            band.path_axis = d;
+      }
       std::vector<dealii::Point<dim>> positions;
       positions.reserve(grain_seeds.size());
       for (const auto &seed : grain_seeds)

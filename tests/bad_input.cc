@@ -242,6 +242,16 @@ end
              "often\nend\n",
          "Every steps",
          "often"},
+        {"adaptivity_band_width_not_a_number",
+         "set Dimension = 2\nsubsection Adaptivity\n set Band width = "
+             "wide\nend\n",
+         "Band width",
+         "wide"},
+        {"adaptivity_band_width_too_large",
+         "set Dimension = 3\nsubsection Adaptivity\n set Band width = "
+             "21\nend\n",
+         "Band width",
+         "21"},
         {"resume_without_checkpoint",
          "set Dimension = 2\nsubsection Checkpoint\n set Resume = true\nend\n",
          "Resume",

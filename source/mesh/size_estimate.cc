@@ -165,16 +165,15 @@ namespace ImmersedGrains
       }
       std::sort(marked.begin(), marked.end());
       marked.erase(std::unique(marked.begin(), marked.end()), marked.end());
-      for (unsigned int d = 0; d < dim; ++d)
+      // Every marked cell and those within @p layers of it along axis d.
+      const auto grow = [&](const unsigned int d, const std::int64_t layers)
       {
         std::vector<std::uint64_t> grown;
-        grown.reserve(marked.size() * (2 * band.band_width + 1));
+        grown.reserve(marked.size() * (2 * layers + 1));
         for (const auto k : marked)
         {
           auto c = coordinates(k);
-          for (std::int64_t o = -static_cast<std::int64_t>(band.band_width);
-               o <= static_cast<std::int64_t>(band.band_width);
-               ++o)
+          for (std::int64_t o = -layers; o <= layers; ++o)
           {
             auto shifted = c;
             shifted[d] += o;
@@ -187,7 +186,16 @@ namespace ImmersedGrains
         std::sort(grown.begin(), grown.end());
         grown.erase(std::unique(grown.begin(), grown.end()), grown.end());
         marked.swap(grown);
-      }
+      };
+      // The paths, in cells of this level: a cell refined here holds
+      // 2^(finest - level) finest cells along an edge.
+      if (const auto path =
+            std::lround(band.lookahead /
+                        std::pow(2.0, static_cast<double>(finest) - level));
+          path > 0 && level < finest)
+        grow(band.path_axis, path);
+      for (unsigned int d = 0; d < dim; ++d)
+        grow(d, band.band_width);
       // Only cells that exist: their parents were refined.
       if (!all)
         marked.erase(std::remove_if(marked.begin(),

@@ -37,7 +37,11 @@ namespace ImmersedGrains
    * criterion `grains`): every cell below @p min_level, and on each level
    * from @p min_level up, the cells within @p band_width layers of a cell
    * that holds a grain, up to @p max_level or to the level whose children
-   * would be smaller than @p smallest_cell.
+   * would be smaller than @p smallest_cell. With @p lookahead (in finest
+   * cells, Adaptivity/Band lookahead) the cells holding grains reach that
+   * far along @p path_axis both ways before the layers grow, for the
+   * grains' paths: where they will go is not known before they move, and
+   * a path of that length along one axis stands for one in any direction.
    */
   struct GrainBand
   {
@@ -45,6 +49,8 @@ namespace ImmersedGrains
     unsigned int max_level     = 0;
     unsigned int band_width    = 0;
     double       smallest_cell = 0;
+    double       lookahead     = 0;
+    unsigned int path_axis     = 0;
   };
 
   /**
