@@ -85,31 +85,33 @@ main(int argc, char **argv)
   // would read as something else (a 10^4-sphere pile came back with 7786
   // grains at infinite speed). It must stop with an input error naming
   // Checkpoint/Resume, before it changes anything.
-  std::string friction_error;
-  const auto  log_size = [](const std::string &directory)
+  // The input error a resume of @p directory with @p text stops with.
+  const auto resume_error =
+    [](const std::string &directory, const std::string &text)
+  {
+    try
+    {
+      run(directory, 0.75, true, MPI_COMM_WORLD, text);
+    }
+    catch (const InputError &e)
+    {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const auto log_size = [](const std::string &directory)
   {
     return std::filesystem::exists(directory + "/log.txt") ?
              std::filesystem::file_size(directory + "/log.txt") :
              std::uintmax_t(0);
   };
   const std::uintmax_t log_before = log_size("resumed");
-  try
-  {
-    run("resumed",
-        0.75,
-        true,
-        MPI_COMM_WORLD,
-        "subsection Contacts\n  set Friction = 0.3\nend\n");
-  }
-  catch (const InputError &e)
-  {
-    friction_error = e.what();
-  }
+  const std::string    friction_error =
+    resume_error("resumed", "subsection Contacts\n  set Friction = 0.3\nend\n");
 
   // Sets written before physics.txt existed are resumed without the check,
   // but never with the band's lookahead: their grains carry no straight
   // paths. (The same run's sets with the file taken away.)
-  std::string unlabelled_error;
   if (root)
   {
     std::filesystem::remove_all("unlabelled");
@@ -121,18 +123,9 @@ main(int argc, char **argv)
       std::filesystem::remove(set.path() / "physics.txt");
   }
   MPI_Barrier(MPI_COMM_WORLD);
-  try
-  {
-    run("unlabelled",
-        0.75,
-        true,
-        MPI_COMM_WORLD,
-        "subsection Adaptivity\n  set Every steps = auto\nend\n");
-  }
-  catch (const InputError &e)
-  {
-    unlabelled_error = e.what();
-  }
+  const std::string unlabelled_error =
+    resume_error("unlabelled",
+                 "subsection Adaptivity\n  set Every steps = auto\nend\n");
 
   // A run straight to step 10, and one stopped after step 5 and resumed
   // from its checkpoint of step 4, with the Adaptivity section @p text.
