@@ -437,7 +437,20 @@ namespace ImmersedGrains
     predicted_impulse.assign(arrays.predicted_impulse.size(),
                              dealii::Tensor<1, dim>());
     cell_drags.assign(triangulation.n_active_cells(), {});
-    reynolds_max = 0;
+    reynolds_max  = 0;
+    felt_drag_sum = dealii::Tensor<1, dim>();
+    // The filtered drag made implicit: the fluid feels beta_h u at each
+    // point, the grains the filtered velocity. For free grains it is taken
+    // against the last step's velocity, beta_h (u - u^n), with their drags
+    // spread less what they felt of u^n: the fluid receives at each point
+    // what the grains' drags spread back, up to the step's change. Taken
+    // whole, it received about -2 beta_h l^2 lap u more, a viscosity
+    // 2 phi_s rho_p l^2 / (dt + tau_p) that slowed a 3D cloud by 18-35 %
+    // (doc/theory.md, "Drag distributions"). Not for fixed and held
+    // grains: their full gamma would make the explicit rest converge over
+    // tens of steps (a packed bed's pressure drop drifted 1 Pa per step).
+    const bool against_last =
+      drag_as_field() && parameters.two_way && parameters.implicit_coupling;
 
     // The fluid solution has not changed since set_grain_forces() filtered
     // it, except before the first step or after a mesh change.
@@ -557,12 +570,21 @@ namespace ImmersedGrains
             }
             // It pulls towards u - u_self: the fluid sees it at v~ + u_self.
             drag.velocity += self;
+            if (against_last)
+            {
+              drag.velocity -= felt[k];
+              drag.against_last_velocity = true;
+              felt_drag_sum += drag.beta * felt[k];
+            }
           }
           cell_drags[cell->active_cell_index()].push_back(drag);
         }
       });
     reynolds_max =
       dealii::Utilities::MPI::max(reynolds_max,
+                                  triangulation.get_communicator());
+    felt_drag_sum =
+      dealii::Utilities::MPI::sum(felt_drag_sum,
                                   triangulation.get_communicator());
     if (filtered_drag)
       filtered_drag->spread(
@@ -737,7 +759,8 @@ namespace ImmersedGrains
       on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
                                                fluid.get_cell_gather(),
                                                fluid.get_solution(),
-                                               solid_scale());
+                                               solid_scale()) +
+                 felt_drag_sum;
     if (!drag_as_field())
     {
       // The point drags through the fluid velocity the grains felt.

@@ -29,9 +29,10 @@ namespace ImmersedGrains
   {
     // Lumped: an M-matrix, so beta_h >= 0 wherever grains are.
     filter.setup(true, length);
-    beta     = filter.make_ghosted_vector();
-    alpha    = filter.make_ghosted_vector();
-    mobility = filter.make_ghosted_vector();
+    beta      = filter.make_ghosted_vector();
+    beta_last = filter.make_ghosted_vector();
+    alpha     = filter.make_ghosted_vector();
+    mobility  = filter.make_ghosted_vector();
     for (unsigned int d = 0; d < dim; ++d)
     {
       free_flux[d]         = filter.make_ghosted_vector();
@@ -49,9 +50,10 @@ namespace ImmersedGrains
       void(const typename dealii::Triangulation<dim>::active_cell_iterator &,
            std::vector<PointDrag<dim>> &)> &drags)
   {
-    auto beta_rhs     = filter.make_owned_vector();
-    auto alpha_rhs    = filter.make_owned_vector();
-    auto mobility_rhs = filter.make_owned_vector();
+    auto beta_rhs      = filter.make_owned_vector();
+    auto beta_last_rhs = filter.make_owned_vector();
+    auto alpha_rhs     = filter.make_owned_vector();
+    auto mobility_rhs  = filter.make_owned_vector();
     std::array<typename HelmholtzFilter<dim>::Vector, dim> flux_rhs;
     for (auto &f : flux_rhs)
       f = filter.make_owned_vector();
@@ -63,7 +65,8 @@ namespace ImmersedGrains
     const unsigned int                           n  = fe.n_dofs_per_cell();
     std::vector<dealii::types::global_dof_index> indices(n);
     std::vector<PointDrag<dim>>                  cell_drags;
-    dealii::Vector<double> cell_beta(n), cell_alpha(n), cell_mobility(n);
+    dealii::Vector<double> cell_beta(n), cell_beta_last(n), cell_alpha(n),
+      cell_mobility(n);
     std::array<dealii::Vector<double>, dim> cell_flux;
     for (auto &f : cell_flux)
       f.reinit(n);
@@ -78,9 +81,10 @@ namespace ImmersedGrains
         drags(cell, cell_drags);
         if (cell_drags.empty())
           continue;
-        cell_beta     = 0;
-        cell_alpha    = 0;
-        cell_mobility = 0;
+        cell_beta      = 0;
+        cell_beta_last = 0;
+        cell_alpha     = 0;
+        cell_mobility  = 0;
         for (auto &f : cell_flux)
           f = 0;
         for (auto &m : cell_momentum)
@@ -90,6 +94,8 @@ namespace ImmersedGrains
           {
             const double N = fe.shape_value(j, drag.reference_location);
             cell_beta(j) += drag.beta * N;
+            if (drag.against_last_velocity)
+              cell_beta_last(j) += drag.beta * N;
             cell_alpha(j) += drag.pressure_weight * N;
             cell_mobility(j) += drag.pressure_mobility * N;
             for (unsigned int d = 0; d < dim; ++d)
@@ -98,6 +104,10 @@ namespace ImmersedGrains
               cell_momentum[d](j) += drag.beta * drag.velocity[d] * N;
           }
         filter.add_cell_contribution(cell, cell_beta, indices, beta_rhs);
+        filter.add_cell_contribution(cell,
+                                     cell_beta_last,
+                                     indices,
+                                     beta_last_rhs);
         filter.add_cell_contribution(cell, cell_alpha, indices, alpha_rhs);
         filter.add_cell_contribution(cell,
                                      cell_mobility,
@@ -115,6 +125,10 @@ namespace ImmersedGrains
                                        momentum_rhs[d]);
       }
     beta_rhs.compress(dealii::VectorOperation::add);
+    beta_last_rhs.compress(dealii::VectorOperation::add);
+    // Filtered only if some grain's drag is against u^n (a norm over all
+    // ranks): otherwise beta_n = 0.
+    against_last = beta_last_rhs.linfty_norm() > 0;
     alpha_rhs.compress(dealii::VectorOperation::add);
     mobility_rhs.compress(dealii::VectorOperation::add);
     for (auto &f : flux_rhs)
@@ -138,6 +152,11 @@ namespace ImmersedGrains
     {
       rhs.push_back(&beta_rhs);
       fields.push_back(&beta);
+      if (against_last)
+      {
+        rhs.push_back(&beta_last_rhs);
+        fields.push_back(&beta_last);
+      }
       for (unsigned int d = 0; d < dim; ++d)
       {
         rhs.push_back(&momentum_rhs[d]);
@@ -401,6 +420,11 @@ namespace ImmersedGrains
       values.drag_coefficient[q] = b;
       for (unsigned int d = 0; d < dim; ++d)
         values.grain_velocity[q][d] = b > 0 ? field_values[d + 1][q] / b : 0.0;
+    }
+    if (against_last)
+    {
+      const auto last = values_at<1>(cell, reference_points, {{&beta_last}});
+      values.last_velocity_drag = last[0];
     }
   }
 

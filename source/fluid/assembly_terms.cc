@@ -134,6 +134,7 @@ namespace ImmersedGrains
   {
     m.reaction += s.beta;
     m.force += s.beta * (s.u - s.grain_velocity);
+    m.force -= s.beta_last * s.u_last;
   }
 
 

@@ -26,20 +26,23 @@ namespace ImmersedGrains
     average_drag_over_cell(const std::vector<double> &JxW,
                            MixtureValues<dim>        &mixture)
     {
-      double                 beta = 0, volume = 0;
+      double                 beta = 0, beta_last = 0, volume = 0;
       dealii::Tensor<1, dim> momentum;
       for (unsigned int q = 0; q < JxW.size(); ++q)
       {
         beta += mixture.drag_coefficient[q] * JxW[q];
+        beta_last += mixture.last_velocity_drag[q] * JxW[q];
         momentum +=
           mixture.drag_coefficient[q] * mixture.grain_velocity[q] * JxW[q];
         volume += JxW[q];
       }
       beta /= volume;
+      beta_last /= volume;
       momentum /= volume;
       for (unsigned int q = 0; q < JxW.size(); ++q)
       {
-        mixture.drag_coefficient[q] = beta;
+        mixture.drag_coefficient[q]   = beta;
+        mixture.last_velocity_drag[q] = beta_last;
         mixture.grain_velocity[q] =
           beta > 0 ? momentum / beta : dealii::Tensor<1, dim>();
       }
@@ -342,6 +345,13 @@ namespace ImmersedGrains
 
       mixture_fields->evaluate(
         cell, points, quadrature.get_points(), time, mixture);
+      // u^n, also where a drag field is taken against it.
+      const bool drag_against_last =
+        std::any_of(mixture.last_velocity_drag.begin(),
+                    mixture.last_velocity_drag.end(),
+                    [](const double b) { return b != 0; });
+      if (drag_against_last && !with_history)
+        cell_gather->gather(cell_number, old_solution, local_old);
       const double h            = std::pow(cell->measure(), 1.0 / dim);
       const double floor_factor = schur_floor_factor(h, wall_gap);
       using DragAveraging       = typename FluidParameters<dim>::DragAveraging;
@@ -374,6 +384,7 @@ namespace ImmersedGrains
         // The current iterate and the history at this point.
         state.u         = dealii::Tensor<1, dim>();
         state.u_history = dealii::Tensor<1, dim>();
+        state.u_last    = dealii::Tensor<1, dim>();
         state.grad_u    = dealii::Tensor<2, dim>();
         state.p         = 0;
         state.grad_p    = dealii::Tensor<1, dim>();
@@ -387,6 +398,8 @@ namespace ImmersedGrains
             if (with_history)
               state.u_history[c] +=
                 (bdf[1] * local_old[k] + bdf[2] * local_older[k]) * N[a];
+            if (drag_against_last)
+              state.u_last[c] += local_old[k] * N[a];
           }
         for (unsigned int b = 0; b < n_p; ++b)
         {
@@ -399,6 +412,7 @@ namespace ImmersedGrains
         state.grad_phi       = mixture.fluid_fraction_gradient[q];
         state.beta           = mixture.drag_coefficient[q];
         state.grain_velocity = mixture.grain_velocity[q];
+        state.beta_last      = mixture.last_velocity_drag[q];
         state.solid_flux     = mixture.solid_flux[q];
         state.mass_source    = mixture.mass_source[q];
         state.alpha          = mixture.pressure_gradient_weight[q];

@@ -15,6 +15,7 @@ namespace ImmersedGrains
     pressure_gradient_weight.assign(n, 0.0);
     pressure_mobility.assign(n, 0.0);
     solid_scale.assign(n, 1.0);
+    last_velocity_drag.assign(n, 0.0);
   }
 
 

@@ -257,6 +257,11 @@ namespace ImmersedGrains
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 
     double reynolds_max = 0;
+    // Sum over free grains of beta_i times the velocity they felt when the
+    // fluid step was prepared: with the filtered drag's deferred correction
+    // their spread drags leave it out and the fluid takes it back as
+    // (beta_n, u^n), the same to round-off (exchanged_forces()).
+    dealii::Tensor<1, dim> felt_drag_sum;
     // Whether the filtered velocity is that of the fluid's current solution.
     bool filtered_velocity_current = false;
   };

@@ -24,7 +24,10 @@ namespace ImmersedGrains
    *
    *   A beta_h = sum_i beta_i N(x_i),   A m_h = sum_i beta_i v~_i N(x_i),
    *
-   * and the fluid's momentum equation gains beta_h u - m_h; each grain feels
+   * and the fluid's momentum equation gains beta_h u - m_h. Drags marked
+   * PointDrag::against_last_velocity are also spread into beta_n, and the
+   * equation gains - beta_n u^n: their v~_i is already less the velocity
+   * they felt of u^n (doc/theory.md "Drag distributions"). Each grain feels
    * the filtered fluid velocity u_bar(x_i), A u_bar = (N, u). Because A is
    * symmetric, sum_i beta_i u_bar(x_i) = (beta_h, u): the grains and the
    * fluid exchange the same momentum to round-off, and since the filter
@@ -155,11 +158,15 @@ namespace ImmersedGrains
     HelmholtzFilter<dim> filter;
 
     // The filter's Q1 shapes at the points last asked for.
-    mutable CellPointShapes<dim>          shapes;
-    const double                          length;
-    const bool                            drag_as_field;
-    const bool                            implicit_velocity;
-    typename HelmholtzFilter<dim>::Vector beta, alpha, mobility;
+    mutable CellPointShapes<dim> shapes;
+    const double                 length;
+    const bool                   drag_as_field;
+    const bool                   implicit_velocity;
+    // Whether beta_n was filtered in the last spread() (some drag was
+    // against the last step's velocity).
+    bool against_last = false;
+    // beta_n: the part of beta from drags against the last step's velocity.
+    typename HelmholtzFilter<dim>::Vector beta, beta_last, alpha, mobility;
     std::array<typename HelmholtzFilter<dim>::Vector, dim> free_flux;
     std::array<typename HelmholtzFilter<dim>::Vector, dim> momentum;
     std::array<typename HelmholtzFilter<dim>::Vector, dim> velocity;

@@ -59,6 +59,7 @@ namespace ImmersedGrains
     dealii::Tensor<1, dim> u;         // current iterate
     dealii::Tensor<2, dim> grad_u;    // (grad u)_cd = du_c/dx_d
     dealii::Tensor<1, dim> u_history; // (a1 u^n + a2 u^{n-1}), BDF weights
+    dealii::Tensor<1, dim> u_last;    // u^n, where the drag field needs it
     double                 p = 0;
     dealii::Tensor<1, dim> grad_p;
 
@@ -66,7 +67,8 @@ namespace ImmersedGrains
     dealii::Tensor<1, dim> grad_phi;
     double                 beta = 0; // drag coefficient field
     dealii::Tensor<1, dim> grain_velocity;
-    dealii::Tensor<1, dim> solid_flux; // (1 - phi) u_p, explicit part
+    double                 beta_last = 0; // its share against u_last
+    dealii::Tensor<1, dim> solid_flux;    // (1 - phi) u_p, explicit part
     double                 mass_source = 0;
     double                 alpha       = 0; // pressure-gradient weight
     double                 mobility    = 0; // pressure mobility k

@@ -38,6 +38,13 @@ namespace ImmersedGrains
     // the fluid fraction is clamped (SolidFraction::solid_scale()); the
     // fields above already include it.
     std::vector<double> solid_scale;
+    // The share of the drag coefficient above whose implicit part is
+    // taken against the last step's velocity u^n (the filtered drag's
+    // deferred correction for free grains, doc/theory.md "Drag
+    // distributions"): the momentum equation gains beta u - beta_n u^n -
+    // beta u_p, where beta u_p already leaves out what those grains felt
+    // of u^n.
+    std::vector<double> last_velocity_drag; // beta_n
   };
 
 
@@ -117,6 +124,10 @@ namespace ImmersedGrains
     double                 pressure_weight   = 0;
     double                 pressure_mobility = 0;
     dealii::Tensor<1, dim> free_flux;
+    // Whether @p velocity is less the velocity the grain felt of the last
+    // step's fluid, so that the fluid's implicit drag for it is
+    // beta (u - u^n) (FilteredDrag, doc/theory.md "Drag distributions").
+    bool against_last_velocity = false;
   };
 
 
