@@ -1,7 +1,9 @@
 // Simulation<dim>::regime() and print_check(): what a scene is, in the
 // numbers that decide which physics it needs, and where its choices leave
-// the range the model is validated for (doc/validation.md).
+// the range the model is validated for (doc/validation.md); and
+// choose_drag_distribution(), which picks the validated one.
 #include <immersed_grains/coupling/drag_law.h>
+#include <immersed_grains/parameters.h>
 #include <immersed_grains/simulation.h>
 
 #include <algorithm>
@@ -154,6 +156,9 @@ namespace ImmersedGrains
                       (two_way ? "two-way" : "one-way")) +
         ", drag law " + coupling_parameters.drag_law + ", drag distribution " +
         coupling_parameters.drag_distribution +
+        (drag_distribution_choice.empty() ?
+           std::string() :
+           " (auto: " + drag_distribution_choice + ")") +
         ", self-disturbance correction " +
         on(coupling_parameters.self_correction) + ", grain sub-steps " +
         on(coupling_parameters.grain_substeps) +
@@ -194,11 +199,13 @@ namespace ImmersedGrains
     // A 2D cloud (a ball of many discs) moves collectively, and each disc's
     // own excess, a few times its lone velocity, is a share of about 1/N
     // of the cloud's: the cell spread is validated on clouds of 321 discs
-    // (cloud_single_fluid_2d), and a ball of fewer than 100 is taken for
-    // separate discs.
+    // (cloud_single_fluid_2d) and on lattices, and a ball of fewer than 100
+    // is taken for separate discs (choose_drag_distribution() reads the
+    // scene the same way).
     const bool cloud_2d =
       grain_parameters.shape == PlacementShape::ball && placed_grains >= 100;
-    if (two_way && dim == 2 && spread_in_cells && !cloud_2d)
+    if (two_way && dim == 2 && spread_in_cells && !cloud_2d &&
+        grain_parameters.shape != PlacementShape::lattice)
       regime.warnings.push_back(
         "2D with Drag distribution = " + coupling_parameters.drag_distribution +
         (grain_parameters.shape == PlacementShape::ball ?
@@ -209,10 +216,30 @@ namespace ImmersedGrains
         ": a disc's own disturbance decays only logarithmically, and a lone "
         "disc settles 2.4-4 times too fast whatever the cell; discs placed "
         "at random settle about twice too fast, from the flows each cell's "
-        "random share of discs drives (doc/validation.md); use Drag "
-        "distribution = filtered with "
-        "Smoothing length about half the box (lone discs and 2D suspensions "
-        "then lie within 0.5 % of the closure)");
+        "random share of discs drives (doc/validation.md); use " +
+        (grain_parameters.shape == PlacementShape::ball ?
+           std::string("a list or box placement for discs that are not a "
+                       "cloud (Drag distribution = auto then filters "
+                       "them), or ") :
+           std::string("Drag distribution = auto (the default), or ")) +
+        "Drag distribution = filtered with Smoothing length about half the "
+        "box (lone discs and 2D suspensions then lie within 0.5 % of the "
+        "closure)");
+    double shortest_side = std::numeric_limits<double>::max();
+    for (unsigned int c = 0; c < dim; ++c)
+      shortest_side =
+        std::min(shortest_side,
+                 geometry.upper_corner[c] - geometry.lower_corner[c]);
+    if (two_way && !spread_in_cells && dim == 2 && !cloud_2d &&
+        l < shortest_side / 4)
+      regime.warnings.push_back(
+        "Smoothing length " + number(l) + " m is " +
+        number(l / shortest_side, 2) +
+        " of the box's shortest side: in 2D a disc feels its own "
+        "disturbance out to the filter's length (a lone disc settles 2.8 % "
+        "too fast with a quarter of the box, discs at random 21-73 % with 8 "
+        "grain radii, doc/validation.md); use about half the box's "
+        "shortest side, or Drag distribution = auto");
     if (two_way && !spread_in_cells && dim == 3 && l < 4 * d &&
         !coupling_parameters.self_correction)
       regime.warnings.push_back(
@@ -301,6 +328,62 @@ namespace ImmersedGrains
   }
 
 
+  template <int dim>
+  void
+  Simulation<dim>::choose_drag_distribution(const std::string &file)
+  {
+    auto &c = coupling_parameters;
+    if (c.drag_distribution != "auto")
+      return;
+    // Where each is validated (doc/validation.md): the cell spread in 3D
+    // (with the self-disturbance correction), and in 2D for clouds placed
+    // as a ball (cloud_single_fluid_2d, 321 discs) and lattices, which
+    // give every cell the same discs (hindered_settling_2d_lattice). Elsewhere
+    // in 2D a disc's own disturbance decays only logarithmically, so that a
+    // lone disc settles 2.4-4 times too fast in cells and discs placed at
+    // random about twice: a filter half the box wide puts both within 0.5 % of
+    // the closure (settling_lone_disc_2d_filtered_*, hindered_settling_2d_*).
+    const auto shape         = grain_parameters.shape;
+    c.drag_distribution      = "cell";
+    drag_distribution_choice = "3D";
+    if (dim == 3)
+      return;
+    drag_distribution_choice = placed_grains == 0 ?
+                                 "2D, no grains placed" :
+                                 "2D, the fluid does not feel the grains";
+    if (!c.two_way || placed_grains == 0)
+      return;
+    // A ball is placed as a cloud; below 100 discs regime() warns that
+    // it is too small to be one.
+    drag_distribution_choice = "2D, a ball placement (a cloud) of " +
+                               std::to_string(placed_grains) +
+                               (placed_grains == 1 ? " disc" : " discs");
+    if (shape == PlacementShape::ball)
+      return;
+    drag_distribution_choice = "2D lattice: the same discs in every cell";
+    if (shape == PlacementShape::lattice)
+      return;
+    c.drag_distribution = "filtered";
+    const auto set      = entries_set_in(file);
+    if (c.projection.smoothing_length > 0 &&
+        std::find(set.begin(), set.end(), "Coupling/Smoothing length") !=
+          set.end())
+    {
+      drag_distribution_choice =
+        "2D discs not in a cloud, a filter of the Smoothing length given";
+      return;
+    }
+    double shortest = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+      shortest =
+        std::min(shortest, geometry.upper_corner[d] - geometry.lower_corner[d]);
+    c.projection.smoothing_length = shortest / 2;
+    drag_distribution_choice =
+      "2D discs not in a cloud: a filter half the box's shortest side, " +
+      number(shortest / 2) + " m";
+  }
+
+
   template SceneRegime
   Simulation<2>::regime() const;
   template SceneRegime
@@ -309,4 +392,8 @@ namespace ImmersedGrains
   Simulation<2>::print_check(std::ostream &) const;
   template void
   Simulation<3>::print_check(std::ostream &) const;
+  template void
+  Simulation<2>::choose_drag_distribution(const std::string &);
+  template void
+  Simulation<3>::choose_drag_distribution(const std::string &);
 } // namespace ImmersedGrains

@@ -384,6 +384,7 @@ namespace ImmersedGrains
       mean_grain_radius += seed.radius / grain_seeds.size();
     }
     placed_grains = grain_seeds.size();
+    choose_drag_distribution(file);
 
     // Stop here, before anything large is allocated or written, if the
     // scene cannot fit: the kernel would kill it half-way instead.
@@ -593,6 +594,10 @@ namespace ImmersedGrains
             << (coupling_parameters.tracers ?
                   ", tracers" :
                   (coupling_parameters.two_way ? ", two-way" : ", one-way"))
+            << ", drag distribution " << coupling_parameters.drag_distribution
+            << (drag_distribution_choice.empty() ?
+                  std::string() :
+                  " (auto: " + drag_distribution_choice + ")")
             << (coupling_parameters.projection.closure_porosity.sphere_packing ?
                   ", porosity of the equivalent sphere packing" :
                   "")

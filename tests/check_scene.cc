@@ -7,9 +7,11 @@
 // coupling (the correction on: none), with a Stokes fluid and the
 // filtered drag (none), and with the default coupling at a solid fraction
 // of 0.3 (a warning: the cell spread is validated up to 0.2). In 2D with the
-// default coupling (the cell spread): a ball of one disc (a warning: a lone
-// disc settles several times too fast) and a cloud of 160 discs (none: the
-// cell spread is validated on 2D clouds).
+// default coupling (Drag distribution = auto): a ball of one disc (the
+// cell spread, as for a cloud, and a warning: a lone disc settles several
+// times too fast), a cloud of 160 discs (the cell spread, validated on 2D
+// clouds: none) and 160 discs in a box (a suspension: the filtered drag
+// with a filter half the box wide, none).
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,13 +21,15 @@
 namespace fs = std::filesystem;
 
 // The grains in a box of 6e-4 m in 3D, or in a ball of radius 3e-4 m in
-// 2D; the domain a cube (square) of 8e-4 m in cells of 2 grain diameters.
+// 2D (@p box_2d: a square of 6e-4 m); the domain a cube (square) of 8e-4 m
+// in cells of 2 grain diameters.
 void
 check(const std::string &name,
       const std::string &coupling,
       const bool         stokes,
-      const unsigned int count = 200,
-      const unsigned int dim   = 3)
+      const unsigned int count  = 200,
+      const unsigned int dim    = 3,
+      const bool         box_2d = false)
 {
   fs::remove_all("out_" + name);
   {
@@ -59,9 +63,12 @@ check(const std::string &name,
       << (dim == 3 ? "    set Shape = box\n"
                      "    set Center = 4e-4, 4e-4, 4e-4\n"
                      "    set Size = 6e-4\n" :
-                     "    set Shape = ball\n"
-                     "    set Center = 4e-4, 4e-4\n"
-                     "    set Size = 3e-4\n")
+                     (box_2d ? "    set Shape = box\n"
+                               "    set Center = 4e-4, 4e-4\n"
+                               "    set Size = 6e-4\n" :
+                               "    set Shape = ball\n"
+                               "    set Center = 4e-4, 4e-4\n"
+                               "    set Size = 3e-4\n"))
       << "    set Count = " << count
       << "\n"
          "  end\n"
@@ -99,4 +106,5 @@ main()
   // A 2D cloud at area fraction 0.28: 160 of the discs' area over the
   // ball's.
   check("cloud_2d", "", false, 160, 2);
+  check("suspension_2d", "", false, 160, 2, true);
 }

@@ -73,6 +73,10 @@ namespace ImmersedGrains
     print_check(std::ostream &out) const;
 
   private:
+    // Resolves Coupling/Drag distribution = auto from the placed grains
+    // (source/scene_regime.cc) and says why in drag_distribution_choice.
+    void
+    choose_drag_distribution(const std::string &file);
     // With @p resumed_step >= 0 the files of the run being resumed are
     // kept up to that step and appended to.
     void
@@ -238,6 +242,8 @@ namespace ImmersedGrains
     double                                  largest_grain_radius = 0;
     double                                  mean_grain_radius    = 0;
     unsigned int                            placed_grains        = 0;
+    // Why Drag distribution = auto became what it is; empty if it was set.
+    std::string drag_distribution_choice;
     // Placed while parsing, so that bad placements fail before any output.
     std::vector<GrainSeed<dim>> grain_seeds;
     SizeEstimate                size_estimate;

@@ -35,8 +35,8 @@ namespace ImmersedGrains
                         "feel nothing else (implies Two-way = false).");
       prm.declare_entry(
         "Drag distribution",
-        "cell",
-        Selection("cell|point|filtered"),
+        "auto",
+        Selection("auto|cell|point|filtered"),
         "How a grain's drag enters the fluid: 'point' through the velocity "
         "shape functions at its centre (deal.II step-70), felt against the "
         "fluid velocity there; 'cell' spread evenly over its cell, felt "
@@ -46,7 +46,12 @@ namespace ImmersedGrains
         "part of its own disturbance of the fluid; with 'point' and 'cell' "
         "that part grows as cells shrink towards the grain size "
         "(doc/validation.md), with 'filtered' it is set by the length in "
-        "metres and does not depend on the mesh.");
+        "metres and does not depend on the mesh. 'auto': 'cell' in 3D; in "
+        "2D, two-way coupled, 'cell' for a cloud (a ball placement) and a "
+        "lattice, 'filtered' for other placements (lone discs, random "
+        "suspensions), with 'Smoothing length' half the box's "
+        "shortest side unless set (a disc's own disturbance decays only "
+        "logarithmically, doc/theory.md); the log says which.");
       prm.declare_entry(
         "Implicit coupling",
         "true",
@@ -144,9 +149,11 @@ namespace ImmersedGrains
         "for ever");
 
       const std::string correction = prm.get("Self-disturbance correction");
-      self_correction              = correction == "auto" ?
-                                       dim == 3 && drag_distribution == "cell" :
-                                       (correction == "true" || correction == "yes");
+      // 'auto' distributions are 'cell' in 3D (Simulation chooses).
+      self_correction = correction == "auto" ?
+                          dim == 3 && (drag_distribution == "cell" ||
+                                       drag_distribution == "auto") :
+                          (correction == "true" || correction == "yes");
       projection.parse_parameters(prm, file);
     }
     prm.leave_subsection();
