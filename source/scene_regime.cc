@@ -225,11 +225,7 @@ namespace ImmersedGrains
         "Drag distribution = filtered with Smoothing length about half the "
         "box (lone discs and 2D suspensions then lie within 0.5 % of the "
         "closure)");
-    double shortest_side = std::numeric_limits<double>::max();
-    for (unsigned int c = 0; c < dim; ++c)
-      shortest_side =
-        std::min(shortest_side,
-                 geometry.upper_corner[c] - geometry.lower_corner[c]);
+    const double shortest_side = geometry.shortest_side();
     if (two_way && !spread_in_cells && dim == 2 && !cloud_2d &&
         l < shortest_side / 4)
       regime.warnings.push_back(
@@ -373,14 +369,10 @@ namespace ImmersedGrains
         "2D discs not in a cloud, a filter of the Smoothing length given";
       return;
     }
-    double shortest = std::numeric_limits<double>::max();
-    for (unsigned int d = 0; d < dim; ++d)
-      shortest =
-        std::min(shortest, geometry.upper_corner[d] - geometry.lower_corner[d]);
-    c.projection.smoothing_length = shortest / 2;
+    c.projection.smoothing_length = geometry.shortest_side() / 2;
     drag_distribution_choice =
       "2D discs not in a cloud: a filter half the box's shortest side, " +
-      number(shortest / 2) + " m";
+      number(c.projection.smoothing_length) + " m";
   }
 
 
