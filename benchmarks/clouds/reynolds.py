@@ -11,8 +11,9 @@ ring radius after 10, 14, 20, 30 and 40 cloud radii of fall.
         [--out DIR] [--analyse-only]
 
 The runs write a checkpoint every 200 steps, so a run that is stopped goes
-on from there when started again. About 1 h 45 min on the 2-core machine
-with two jobs (the Re_c 0.4 run alone takes 70 min on one core).
+on from there when started again. Run side by side on the 2-core machine
+(three at once) they took 78, 60 and 81 minutes; with two jobs, the
+default, count on about two hours.
 
 The ring radius is the median distance of the beads from the vertical
 through their centroid, read from the written states (every 50 steps) and
