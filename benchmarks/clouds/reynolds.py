@@ -8,7 +8,7 @@ and its Reynolds number, the fall after which the axis is empty, and the
 ring radius after 10, 14, 20, 30 and 40 cloud radii of fall.
 
     benchmarks/clouds/reynolds.py [--only re0.4,re1,re3] [--jobs 2]
-        [--out DIR] [--analyse-only]
+        [--out DIR] [--analyse-only] [--states]
 
 The runs write a checkpoint every 200 steps, so a run that is stopped goes
 on from there when started again. Run side by side on the 2-core machine
@@ -18,7 +18,11 @@ default, count on about two hours.
 The ring radius is the median distance of the beads from the vertical
 through their centroid, read from the written states (every 50 steps) and
 interpolated in the fall; the axis is empty from the first written state
-after which fewer than 10 beads lie within R/5 of that vertical.
+after which fewer than 10 beads lie within R/5 of that vertical. --states also prints, per written state, the fall, the
+beads near the axis, the ring radius and the ring's roundness: the beads
+between 0.6 and 1.4 ring radii counted in 24 sectors of 15 degrees around
+the vertical (the largest count over the smallest) and the spread of the
+sectors' mean heights.
 """
 import argparse
 import concurrent.futures
@@ -65,7 +69,19 @@ def scene_text(end, density, viscosity, tall):
     return text + "\nsubsection Checkpoint\n  set Every steps = 200\nend\n"
 
 
-def analyse(directory, density, viscosity):
+def roundness(x, c, r):
+    """The ring's beads per 15-degree sector, largest over smallest, and the
+    spread of the sectors' mean heights [m]."""
+    ring = np.abs(r / np.median(r) - 1) < 0.4
+    sector = (np.degrees(np.arctan2(x[ring, 1] - c[1], x[ring, 0] - c[0]))
+              % 360 // 15).astype(int)
+    counts = np.bincount(sector, minlength=24)
+    heights = [x[ring, 2][sector == k].mean() for k in range(24)
+               if counts[k] > 0]
+    return counts.max() / max(counts.min(), 1), max(heights) - min(heights)
+
+
+def analyse(directory, density, viscosity, print_states=False):
     states = []
     z0 = None
     for t, pieces in plot_cloud.written_states(directory, "particles"):
@@ -75,6 +91,12 @@ def analyse(directory, density, viscosity):
         r = np.hypot(x[:, 0] - c[0], x[:, 1] - c[1])
         states.append((t, (z0 - c[2]) / R, int(np.sum(r < R / 5)),
                        np.median(r) / R))
+        if print_states:
+            factor, spread = roundness(x, c, r)
+            print("%s %.3f s: fall %.1f R, %d beads near the axis, ring "
+                  "%.2f R, sectors %.2f, heights %.3f mm" % (
+                      os.path.basename(directory), t, states[-1][1],
+                      states[-1][2], states[-1][3], factor, 1e3 * spread))
     falls = np.array([s[1] for s in states])
     rings = np.array([s[3] for s in states])
     ring = " / ".join("%.2f" % np.interp(f, falls, rings)
@@ -102,6 +124,8 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", default=WORK)
     parser.add_argument("--analyse-only", action="store_true")
+    parser.add_argument("--states", action="store_true",
+                        help="print every written state's ring figures")
     args = parser.parse_args()
     names = args.only.split(",")
     for name in names:
@@ -114,13 +138,13 @@ def main():
                                      os.path.join(args.out, name))
                          for name in names]:
                 done.result()
+    rows = [analyse(os.path.join(args.out, name), *RUNS[name][1:3],
+                    print_states=args.states) for name in names]
     print("| liquid: ρ (kg/m³), μ (Pa·s) | peak cloud velocity, its Re_c "
           "| axis empty after | ring radius after %s R of fall | run |"
           % " / ".join(map(str, FALLS)))
     print("|---|---|---|---|---|")
-    for name in names:
-        _, density, viscosity, _ = RUNS[name]
-        print(analyse(os.path.join(args.out, name), density, viscosity))
+    print("\n".join(rows))
 
 
 if __name__ == "__main__":
