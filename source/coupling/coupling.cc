@@ -759,9 +759,9 @@ namespace ImmersedGrains
                                   const FluidSolver<dim> &fluid) const
   {
     const MPI_Comm         comm = triangulation.get_communicator();
-    dealii::Tensor<1, dim> on_fluid, on_grains;
+    dealii::Tensor<1, dim> on_fluid;
     if (!parameters.two_way)
-      return {on_fluid, on_grains};
+      return {on_fluid, on_fluid};
     if (filtered_drag)
       on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
                                                fluid.get_cell_gather(),
@@ -785,13 +785,24 @@ namespace ImmersedGrains
         });
       on_fluid += dealii::Utilities::MPI::sum(point_force, comm);
     }
+    return {on_fluid, drag_on_grains(grains)};
+  }
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  Coupling<dim>::drag_on_grains(const Grains<dim> &grains) const
+  {
+    dealii::Tensor<1, dim> on_grains;
+    if (!parameters.two_way)
+      return on_grains;
     // The drag in the grains' implicit update, with their final velocity.
     const auto &arrays = grains.step_arrays();
     for (unsigned int i = 0; i < arrays.drag_coefficient.size(); ++i)
       on_grains += arrays.drag_coefficient[i] *
                    (arrays.drag_velocity[i] - arrays.contact.velocity[i]);
-    on_grains = dealii::Utilities::MPI::sum(on_grains, comm);
-    return {on_fluid, on_grains};
+    return dealii::Utilities::MPI::sum(on_grains,
+                                       triangulation.get_communicator());
   }
 
 

@@ -151,6 +151,15 @@ namespace ImmersedGrains
     exchanged_forces(const Grains<dim>      &grains,
                      const FluidSolver<dim> &fluid) const;
 
+    /**
+     * The drag force on the grains in their last implicit update (global):
+     * sum_i beta_i (u_i - v_i) with the velocities after its contacts. With
+     * grain sub-steps, called after each, it adds up the drag impulse the
+     * grains received over a fluid step.
+     */
+    dealii::Tensor<1, dim>
+    drag_on_grains(const Grains<dim> &grains) const;
+
     /** Integral of the projected solid fraction. */
     double
     solid_volume() const;
