@@ -81,6 +81,10 @@ namespace ImmersedGrains
         c.push_back(name);
       // Fluid steps taken again shorter after a failure, since the start.
       c.emplace_back("step_retries");
+      // The drag impulse the fluid owes the grains at the step's end over
+      // the step's, and the books since the start (doc/output.md).
+      c.emplace_back("momentum_exchange_owed");
+      c.emplace_back("momentum_exchange_drift");
       return c;
     }
 
@@ -978,6 +982,10 @@ namespace ImmersedGrains
           << band_made_at << ' ' << drift.displacement << ' ' << drift.velocity
           << '\n';
     }
+    out << "momentum_exchange " << std::hexfloat << exchanged_impulse;
+    for (unsigned int d = 0; d < dim; ++d)
+      out << ' ' << exchange_imbalance[d];
+    out << '\n';
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
@@ -1050,6 +1058,25 @@ namespace ImmersedGrains
     {
       in.clear();
       in.seekg(lookahead_position);
+    }
+    // Absent before momentum_exchange_drift: its books start at the resume.
+    exchanged_impulse            = 0;
+    exchange_imbalance           = dealii::Tensor<1, dim>();
+    const auto exchange_position = in.tellg();
+    if (in >> text && text == "momentum_exchange")
+    {
+      in >> text;
+      exchanged_impulse = std::strtod(text.c_str(), nullptr);
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        in >> text;
+        exchange_imbalance[d] = std::strtod(text.c_str(), nullptr);
+      }
+    }
+    else
+    {
+      in.clear();
+      in.seekg(exchange_position);
     }
     statistics.load_values(in);
     AssertThrow(!in.bad(),
@@ -1396,27 +1423,43 @@ namespace ImmersedGrains
     // over the step, integrated through its own fields, against the drag
     // the grains' implicit updates received, summed over the sub-steps
     // (with more than one, the later ones re-evaluate the drag the fluid's
-    // prediction assumed: the difference is the multirate scheme's).
-    const auto [on_fluid, first_on_grains] =
-      coupling->exchanged_forces(*grains, *fluid);
-    dealii::Tensor<1, dim> on_grains = first_on_grains;
-    report.removed                   = grains->move_and_scatter(substep);
+    // prediction assumed; the difference is owed to the fluid, and repaid
+    // in the next step unless Coupling/Repay drag mismatch = false).
+    const dealii::Tensor<1, dim> on_fluid =
+      coupling->drag_on_fluid(*grains, *fluid);
+    dealii::Tensor<1, dim> on_grains =
+      coupling->account_drag_on_grains(*grains, substep);
+    dealii::Tensor<1, dim> owed;
+    if (substeps == 1)
+      owed = coupling->exchange_owed(*grains);
+    report.removed = grains->move_and_scatter(substep);
     for (unsigned int k = 1; k < substeps; ++k)
     {
       grains->gather();
       coupling->set_substep_grain_forces(*grains, *fluid, substep);
       grains->compute_free_velocities(substep);
       GrainStepReport later = grains->resolve_contacts(substep, true);
-      on_grains += coupling->drag_on_grains(*grains);
+      on_grains += coupling->account_drag_on_grains(*grains, substep);
+      if (k + 1 == substeps)
+        owed = coupling->exchange_owed(*grains);
       later.removed = grains->move_and_scatter(substep);
       report.add_substep(later);
     }
     // The step's mean drag on the grains.
     on_grains /= substeps;
     statistics.set("drag_force_on_grains", on_grains.norm());
+    const double exchanged = dt * on_grains.norm();
     statistics.set("momentum_exchange_error",
-                   on_grains.norm() > 0 ?
+                   exchanged > 0 ?
                      (on_fluid + on_grains).norm() / on_grains.norm() :
+                     0.0);
+    statistics.set("momentum_exchange_owed",
+                   exchanged > 0 ? owed.norm() / exchanged : 0.0);
+    exchange_imbalance += dt * (on_fluid + on_grains);
+    exchanged_impulse += exchanged;
+    statistics.set("momentum_exchange_drift",
+                   exchanged_impulse > 0 ?
+                     (exchange_imbalance - owed).norm() / exchanged_impulse :
                      0.0);
     return report;
   }

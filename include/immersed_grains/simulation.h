@@ -228,6 +228,11 @@ namespace ImmersedGrains
     std::string                     pressure_drop_text;
     unsigned int                    clamped_nodes_before  = 0;
     unsigned int                    preconditioner_builds = 0;
+    // The drag impulses the phases exchanged since the run (or resume)
+    // began: their sum, which the fluid still owes where the books
+    // balance, and the grains' total (momentum_exchange_drift).
+    dealii::Tensor<1, dim> exchange_imbalance;
+    double                 exchanged_impulse = 0;
     // Steps whose contact solve stopped at Contacts/Max iterations.
     unsigned int capped_contact_steps = 0;
 

@@ -97,6 +97,17 @@ namespace ImmersedGrains
         "(doc/theory.md, \"Contacts and the drag the fluid receives\"). "
         "Grains held by their contacts do not use it.");
       prm.declare_entry(
+        "Repay drag mismatch",
+        "true",
+        Bool(),
+        "The drag impulse a grain received over a fluid step and the fluid "
+        "did not (its sub-steps' drags against the one the fluid's step "
+        "assumed, a contact impulse other than the predicted one) is given "
+        "to the fluid at the grain in the next step, so that over a run the "
+        "phases exchange the same momentum, up to the last step's "
+        "(statistics momentum_exchange_owed and momentum_exchange_drift, "
+        "doc/theory.md). false: the mismatch is reported, not repaid.");
+      prm.declare_entry(
         "Self-disturbance correction",
         "auto",
         Selection("auto|true|false|yes|no"),
@@ -141,6 +152,7 @@ namespace ImmersedGrains
       grain_substeps            = prm.get_bool("Grain sub-steps");
       resting_threshold         = prm.get_double("Resting threshold");
       impulse_prediction_weight = prm.get_double("Impulse prediction weight");
+      repay_drag_mismatch       = prm.get_bool("Repay drag mismatch");
       InputLocation{file, "Coupling"}.require(
         impulse_prediction_weight > 0,
         "Impulse prediction weight",
@@ -444,6 +456,11 @@ namespace ImmersedGrains
     predicted_impulse.assign(arrays.predicted_impulse.size(),
                              dealii::Tensor<1, dim>());
     cell_drags.assign(triangulation.n_active_cells(), {});
+    assumed_beta.assign(n, 0.0);
+    assumed_pressure_weight.assign(n, 0.0);
+    assumed_velocity.assign(n, dealii::Tensor<1, dim>());
+    const bool repay = parameters.two_way && parameters.repay_drag_mismatch &&
+                       !arrays.exchange_owed.empty();
     reynolds_max  = 0;
     felt_drag_sum = dealii::Tensor<1, dim>();
     // The filtered drag made implicit: the fluid feels beta_h u at each
@@ -577,12 +594,19 @@ namespace ImmersedGrains
             }
             // It pulls towards u - u_self: the fluid sees it at v~ + u_self.
             drag.velocity += self;
-            if (against_last)
-            {
-              drag.velocity -= felt[k];
-              drag.against_last_velocity = true;
-              felt_drag_sum += drag.beta * felt[k];
-            }
+          }
+          assumed_beta[i]            = drag.beta;
+          assumed_pressure_weight[i] = drag.pressure_weight;
+          assumed_velocity[i]        = drag.velocity;
+          // What the fluid owes the grain from the last step, as a force
+          // over this one: -beta (u - v) - owed / dt.
+          if (repay && drag.beta > 0)
+            drag.velocity -= arrays.exchange_owed[i] / (drag.beta * dt);
+          if (against_last && !arrays.fixed[i] && !held)
+          {
+            drag.velocity -= felt[k];
+            drag.against_last_velocity = true;
+            felt_drag_sum += drag.beta * felt[k];
           }
           cell_drags[cell->active_cell_index()].push_back(drag);
         }
@@ -693,6 +717,20 @@ namespace ImmersedGrains
           const unsigned int k    = i - first;
           const auto        &u    = felt[k];
           arrays.drag_velocity[i] = u;
+          // The fluid's step assumed this drag impulse; the grain's own
+          // (sub-)steps add theirs (account_drag_on_grains()).
+          if (as_predicted && parameters.two_way &&
+              !arrays.exchange_owed.empty())
+          {
+            // With the grains' new velocities eliminated into the fluid
+            // solve, the fluid received alpha grad p as well (alpha = V
+            // theta, the share of the pressure force the drag takes back).
+            dealii::Tensor<1, dim> assumed =
+              assumed_beta[i] * (u - assumed_velocity[i]);
+            if (assumed_pressure_weight[i] > 0)
+              assumed += assumed_pressure_weight[i] * pressure_gradient[k];
+            arrays.exchange_owed[i] = -dt * assumed;
+          }
           if (as_predicted && !arrays.self_velocity.empty())
           {
             arrays.drag_velocity[i] -= self_velocity[i];
@@ -754,14 +792,14 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  std::pair<dealii::Tensor<1, dim>, dealii::Tensor<1, dim>>
-  Coupling<dim>::exchanged_forces(const Grains<dim>      &grains,
-                                  const FluidSolver<dim> &fluid) const
+  dealii::Tensor<1, dim>
+  Coupling<dim>::drag_on_fluid(const Grains<dim>      &grains,
+                               const FluidSolver<dim> &fluid) const
   {
     const MPI_Comm         comm = triangulation.get_communicator();
     dealii::Tensor<1, dim> on_fluid;
     if (!parameters.two_way)
-      return {on_fluid, on_fluid};
+      return on_fluid;
     if (filtered_drag)
       on_fluid = filtered_drag->force_on_fluid(fluid.get_dof_handler(),
                                                fluid.get_cell_gather(),
@@ -785,24 +823,43 @@ namespace ImmersedGrains
         });
       on_fluid += dealii::Utilities::MPI::sum(point_force, comm);
     }
-    return {on_fluid, drag_on_grains(grains)};
+    return on_fluid;
   }
 
 
   template <int dim>
   dealii::Tensor<1, dim>
-  Coupling<dim>::drag_on_grains(const Grains<dim> &grains) const
+  Coupling<dim>::account_drag_on_grains(Grains<dim> &grains,
+                                        const double substep) const
   {
     dealii::Tensor<1, dim> on_grains;
     if (!parameters.two_way)
       return on_grains;
     // The drag in the grains' implicit update, with their final velocity.
-    const auto &arrays = grains.step_arrays();
+    auto      &arrays = grains.step_arrays();
+    const bool owed   = !arrays.exchange_owed.empty();
     for (unsigned int i = 0; i < arrays.drag_coefficient.size(); ++i)
-      on_grains += arrays.drag_coefficient[i] *
-                   (arrays.drag_velocity[i] - arrays.contact.velocity[i]);
+    {
+      const dealii::Tensor<1, dim> drag =
+        arrays.drag_coefficient[i] *
+        (arrays.drag_velocity[i] - arrays.contact.velocity[i]);
+      on_grains += drag;
+      if (owed)
+        arrays.exchange_owed[i] += substep * drag;
+    }
     return dealii::Utilities::MPI::sum(on_grains,
                                        triangulation.get_communicator());
+  }
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  Coupling<dim>::exchange_owed(const Grains<dim> &grains) const
+  {
+    dealii::Tensor<1, dim> owed;
+    for (const auto &o : grains.step_arrays().exchange_owed)
+      owed += o;
+    return dealii::Utilities::MPI::sum(owed, triangulation.get_communicator());
   }
 
 

@@ -42,6 +42,7 @@ namespace ImmersedGrains
       l.fluid_force   = add("fluid_force", dim, true);
       l.drag_force    = add("drag_force", dim, true);
       l.self_velocity = add("self_velocity", dim, true);
+      l.exchange_owed = add("exchange_owed", dim, true);
     }
     if (with_fluid && prm.contacts_enabled)
     {
@@ -488,6 +489,7 @@ namespace ImmersedGrains
     const bool drags = properties.drag_force != GrainPropertyLayout::absent;
     arrays.drag_force.resize(drags ? n : 0);
     arrays.self_velocity.resize(drags ? n : 0);
+    arrays.exchange_owed.resize(drags ? n : 0);
 
     unsigned int i = 0;
     for (const auto &p : particles)
@@ -517,6 +519,7 @@ namespace ImmersedGrains
         {
           arrays.drag_force[i][d]    = props[properties.drag_force + d];
           arrays.self_velocity[i][d] = props[properties.self_velocity + d];
+          arrays.exchange_owed[i][d] = props[properties.exchange_owed + d];
         }
       ++i;
     }
@@ -808,6 +811,7 @@ namespace ImmersedGrains
         {
           props[properties.drag_force + d]    = drag[d];
           props[properties.self_velocity + d] = arrays.self_velocity[i][d];
+          props[properties.exchange_owed + d] = arrays.exchange_owed[i][d];
         }
       }
       if (friction)

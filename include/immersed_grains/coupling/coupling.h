@@ -73,6 +73,7 @@ namespace ImmersedGrains
       bool        grain_substeps            = true;
       double      resting_threshold         = 1e-3;
       double      impulse_prediction_weight = 1. / 3;
+      bool        repay_drag_mismatch       = true;
       bool        self_correction           = false;
       typename SolidFraction<dim>::Parameters projection;
     };
@@ -142,23 +143,27 @@ namespace ImmersedGrains
       MixtureValues<dim>                    &values) const override;
 
     /**
-     * The drag force the grains exert on the fluid, integrated through the
-     * fluid's own fields, and minus the drag force the fluid exerts on the
-     * grains summed over grains (both global, of the last step); their sum
-     * is the momentum exchange error.
-     */
-    std::pair<dealii::Tensor<1, dim>, dealii::Tensor<1, dim>>
-    exchanged_forces(const Grains<dim>      &grains,
-                     const FluidSolver<dim> &fluid) const;
-
-    /**
-     * The drag force on the grains in their last implicit update (global):
-     * sum_i beta_i (u_i - v_i) with the velocities after its contacts. With
-     * grain sub-steps, called after each, it adds up the drag impulse the
-     * grains received over a fluid step.
+     * The drag force the grains exert on the fluid over the last fluid
+     * step, integrated through the fluid's own fields (global).
      */
     dealii::Tensor<1, dim>
-    drag_on_grains(const Grains<dim> &grains) const;
+    drag_on_fluid(const Grains<dim>      &grains,
+                  const FluidSolver<dim> &fluid) const;
+
+    /**
+     * After each grain (sub-)step of length @p substep: the drag force on
+     * the grains in its implicit update (global), sum_i beta_i (u_i - v_i)
+     * with the velocities after its contacts; and each grain's drag
+     * impulse added to what the fluid owes it (GrainStepArrays::
+     * exchange_owed, which set_grain_forces() started from minus the
+     * impulse the fluid's step assumed).
+     */
+    dealii::Tensor<1, dim>
+    account_drag_on_grains(Grains<dim> &grains, double substep) const;
+
+    /** The sum of what the fluid owes the grains (global, N s). */
+    dealii::Tensor<1, dim>
+    exchange_owed(const Grains<dim> &grains) const;
 
     /** Integral of the projected solid fraction. */
     double
@@ -262,6 +267,12 @@ namespace ImmersedGrains
     // The contact impulse the fluid is told each grain will receive
     // (prepare_fluid_drag()).
     std::vector<dealii::Tensor<1, dim>> predicted_impulse;
+    // The drag the fluid's step assumed for each grain, beta (u - v) +
+    // alpha grad p, with u the velocity it feels and v this
+    // (prepare_fluid_drag()), before the repayment of what it owed.
+    std::vector<double>                 assumed_beta;
+    std::vector<double>                 assumed_pressure_weight;
+    std::vector<dealii::Tensor<1, dim>> assumed_velocity;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 
@@ -269,7 +280,7 @@ namespace ImmersedGrains
     // Sum over free grains of beta_i times the velocity they felt when the
     // fluid step was prepared: with the filtered drag's deferred correction
     // their spread drags leave it out and the fluid takes it back as
-    // (beta_n, u^n), the same to round-off (exchanged_forces()).
+    // (beta_n, u^n), the same to round-off (drag_on_fluid()).
     dealii::Tensor<1, dim> felt_drag_sum;
     // Whether the filtered velocity is that of the fluid's current solution.
     bool filtered_velocity_current = false;

@@ -42,6 +42,7 @@ namespace ImmersedGrains
     unsigned int self_velocity     = absent;
     unsigned int contact_impulse   = absent;
     unsigned int predicted_impulse = absent;
+    unsigned int exchange_owed     = absent;
     unsigned int fixed             = absent;
     /** Adaptivity/Band lookahead: the velocity each grain had when the
      *  band was made, and how far it has strayed since from the straight
@@ -115,6 +116,11 @@ namespace ImmersedGrains
      *  (Coupling/Self-disturbance correction), of the last step on
      *  gather(); the coupling sets this step's. */
     std::vector<dealii::Tensor<1, dim>> self_velocity;
+    /** With a fluid: the drag impulse the grain received and the fluid has
+     *  not [N s] (its sub-steps' drags against the one the fluid's step
+     *  assumed), of the last step on gather(), which the coupling hands
+     *  the fluid this step; the coupling accounts this step's. */
+    std::vector<dealii::Tensor<1, dim>> exchange_owed;
   };
 
   /** Global measures of the grain population (sums/means over ranks). */
