@@ -1399,7 +1399,8 @@ namespace ImmersedGrains
       auto &c                  = arrays.contact;
       c.velocity               = c.start_velocity;
     }
-    coupling->prepare_fluid_drag(*grains, *fluid, dt);
+    // (The dt column still holds the last step's, restored on resume.)
+    coupling->prepare_fluid_drag(*grains, *fluid, dt, statistics.get("dt"));
     const auto stats = fluid->solve_time_step(time + dt, dt);
     fluid_iterations = stats.linear_iterations;
     statistics.set("fluid_nonlinear_iterations", stats.nonlinear_iterations);
@@ -1431,7 +1432,7 @@ namespace ImmersedGrains
       coupling->account_drag_on_grains(*grains, substep);
     dealii::Tensor<1, dim> owed;
     if (substeps == 1)
-      owed = coupling->exchange_owed(*grains);
+      owed = coupling->settle_exchange_owed(*grains);
     report.removed = grains->move_and_scatter(substep);
     for (unsigned int k = 1; k < substeps; ++k)
     {
@@ -1441,7 +1442,7 @@ namespace ImmersedGrains
       GrainStepReport later = grains->resolve_contacts(substep, true);
       on_grains += coupling->account_drag_on_grains(*grains, substep);
       if (k + 1 == substeps)
-        owed = coupling->exchange_owed(*grains);
+        owed = coupling->settle_exchange_owed(*grains);
       later.removed = grains->move_and_scatter(substep);
       report.add_substep(later);
     }

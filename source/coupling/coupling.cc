@@ -102,11 +102,13 @@ namespace ImmersedGrains
         Bool(),
         "The drag impulse a grain received over a fluid step and the fluid "
         "did not (its sub-steps' drags against the one the fluid's step "
-        "assumed, a contact impulse other than the predicted one) is given "
-        "to the fluid at the grain in the next step, so that over a run the "
-        "phases exchange the same momentum, up to the last step's "
-        "(statistics momentum_exchange_owed and momentum_exchange_drift, "
-        "doc/theory.md). false: the mismatch is reported, not repaid.");
+        "assumed) is given to the fluid at the grain in the next step, so "
+        "that over a run the phases exchange the same momentum, up to the "
+        "last step's (statistics momentum_exchange_owed and "
+        "momentum_exchange_drift, doc/theory.md). Not for a grain with a "
+        "contact impulse in the step, nor the error of a predicted one: "
+        "the relaxed prediction (Impulse prediction weight) carries those. "
+        "false: the mismatch is reported, not repaid.");
       prm.declare_entry(
         "Self-disturbance correction",
         "auto",
@@ -444,12 +446,17 @@ namespace ImmersedGrains
   void
   Coupling<dim>::prepare_fluid_drag(const Grains<dim>      &grains,
                                     const FluidSolver<dim> &fluid,
-                                    const double            dt)
+                                    const double            dt,
+                                    const double            previous_dt)
   {
     dealii::TimerOutput::Scope scope(timer, "coupling: interaction force");
     auto                      &arrays = grains.step_arrays();
     const auto                &c      = arrays.contact;
     const unsigned int         n      = c.velocity.size();
+    // Repaid over a step as short as a run's last sliver, the whole debt
+    // of a long step would be a force many times the drag (a Stokes fluid
+    // answers it at once): a shorter step repays its share, the rest waits.
+    repaid_share = (previous_dt > dt ? dt / previous_dt : 1.0);
     lagged_force.assign(n, dealii::Tensor<1, dim>());
     gamma.assign(n, 0.0);
     self_velocity.assign(n, dealii::Tensor<1, dim>());
@@ -598,10 +605,15 @@ namespace ImmersedGrains
           assumed_beta[i]            = drag.beta;
           assumed_pressure_weight[i] = drag.pressure_weight;
           assumed_velocity[i]        = drag.velocity;
+          // The predicted contact impulse is the prediction's to repay
+          // (settle_exchange_owed()): owed is what the sub-steps leave.
+          if (!arrays.fixed[i] && !held && !predicted_impulse.empty())
+            assumed_velocity[i] -= predicted_impulse[i] / m;
           // What the fluid owes the grain from the last step, as a force
           // over this one: -beta (u - v) - owed / dt.
           if (repay && drag.beta > 0)
-            drag.velocity -= arrays.exchange_owed[i] / (drag.beta * dt);
+            drag.velocity -=
+              repaid_share * arrays.exchange_owed[i] / (drag.beta * dt);
           if (against_last && !arrays.fixed[i] && !held)
           {
             drag.velocity -= felt[k];
@@ -729,7 +741,12 @@ namespace ImmersedGrains
               assumed_beta[i] * (u - assumed_velocity[i]);
             if (assumed_pressure_weight[i] > 0)
               assumed += assumed_pressure_weight[i] * pressure_gradient[k];
-            arrays.exchange_owed[i] = -dt * assumed;
+            // What this step did not repay stays owed.
+            const double kept = !parameters.repay_drag_mismatch ? 0.0 :
+                                assumed_beta[i] > 0 ? 1 - repaid_share :
+                                                      1.0;
+            arrays.exchange_owed[i] =
+              kept * arrays.exchange_owed[i] - dt * assumed;
           }
           if (as_predicted && !arrays.self_velocity.empty())
           {
@@ -854,11 +871,17 @@ namespace ImmersedGrains
 
   template <int dim>
   dealii::Tensor<1, dim>
-  Coupling<dim>::exchange_owed(const Grains<dim> &grains) const
+  Coupling<dim>::settle_exchange_owed(Grains<dim> &grains) const
   {
+    auto                  &arrays = grains.step_arrays();
     dealii::Tensor<1, dim> owed;
-    for (const auto &o : grains.step_arrays().exchange_owed)
-      owed += o;
+    for (unsigned int i = 0; i < arrays.exchange_owed.size(); ++i)
+    {
+      if (!arrays.contact_impulse.empty() &&
+          arrays.contact_impulse[i].norm() > 0)
+        arrays.exchange_owed[i] = dealii::Tensor<1, dim>();
+      owed += arrays.exchange_owed[i];
+    }
     return dealii::Utilities::MPI::sum(owed, triangulation.get_communicator());
   }
 

@@ -99,10 +99,14 @@ namespace ImmersedGrains
     void
     project(const Grains<dim> &grains);
 
+    /** @p previous_dt, the last fluid step's length (0 before the first):
+     *  what the fluid owes the grains is repaid at most at the rate at
+     *  which it arose, a share dt / previous_dt when the step shrinks. */
     void
     prepare_fluid_drag(const Grains<dim>      &grains,
                        const FluidSolver<dim> &fluid,
-                       double                  dt);
+                       double                  dt,
+                       double                  previous_dt = 0);
 
     /** Call after Grains::gather(), before compute_free_velocities(). */
     void
@@ -161,9 +165,17 @@ namespace ImmersedGrains
     dealii::Tensor<1, dim>
     account_drag_on_grains(Grains<dim> &grains, double substep) const;
 
-    /** The sum of what the fluid owes the grains (global, N s). */
+    /**
+     * After a step's last grain (sub-)step: the sum of what the fluid owes
+     * the grains (global, N s), after clearing it for grains that touched
+     * another or a wall in the step (a contact impulse, or one predicted):
+     * their mismatch is mostly the predicted contact impulse's error,
+     * which the relaxed prediction (Impulse prediction weight) carries
+     * into the following steps; repaid at once as well, it brought back
+     * the alternation that the prediction removes (doc/theory.md).
+     */
     dealii::Tensor<1, dim>
-    exchange_owed(const Grains<dim> &grains) const;
+    settle_exchange_owed(Grains<dim> &grains) const;
 
     /** Integral of the projected solid fraction. */
     double
@@ -273,6 +285,8 @@ namespace ImmersedGrains
     std::vector<double>                 assumed_beta;
     std::vector<double>                 assumed_pressure_weight;
     std::vector<dealii::Tensor<1, dim>> assumed_velocity;
+    // The share of what it owed that the fluid's step repays.
+    double repaid_share = 1;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 
