@@ -1026,58 +1026,45 @@ namespace ImmersedGrains
         records->emplace_back(std::strtod(text.c_str(), nullptr), file);
       }
     }
+    // Lines added to state.txt after its first version: KEYWORD and
+    // @p n values (hexfloat), or absent in older checkpoints, which then
+    // leaves the stream where it was and returns nothing.
+    const auto optional_line =
+      [&in, &text](const std::string &keyword, const unsigned int n)
+    {
+      std::vector<double> values;
+      const auto          position = in.tellg();
+      if (in >> text && text == keyword)
+        for (unsigned int k = 0; k < n && in >> text; ++k)
+          values.push_back(std::strtod(text.c_str(), nullptr));
+      if (values.size() != n)
+      {
+        values.clear();
+        in.clear();
+        in.seekg(position);
+      }
+      return values;
+    };
     // Absent from checkpoints written before Adaptivity/Every steps = auto:
     // the next adaptation then comes a little later than it would have.
-    grain_travel        = 0;
-    const auto position = in.tellg();
-    if (in >> text && text == "grain_travel" && in >> text)
-      grain_travel = std::strtod(text.c_str(), nullptr);
-    else
-    {
-      in.clear();
-      in.seekg(position);
-    }
+    const auto travel = optional_line("grain_travel", 1);
+    grain_travel      = travel.empty() ? 0 : travel[0];
     // Absent before Adaptivity/Band lookahead: the band then lasts until
     // the grains have travelled its allowance.
-    const auto lookahead_position = in.tellg();
-    if (in >> text && text == "band_lookahead")
+    const auto lookahead = optional_line("band_lookahead", 4);
+    if (!lookahead.empty())
     {
-      std::array<double, 4> values;
-      for (double &v : values)
-      {
-        in >> text;
-        v = std::strtod(text.c_str(), nullptr);
-      }
       if (adaptivity)
-        adaptivity->set_lookahead_horizon(values[0]);
-      band_made_at = values[1];
+        adaptivity->set_lookahead_horizon(lookahead[0]);
+      band_made_at = lookahead[1];
       if (grains)
-        grains->straight_path_drift() = {values[2], values[3]};
-    }
-    else
-    {
-      in.clear();
-      in.seekg(lookahead_position);
+        grains->straight_path_drift() = {lookahead[2], lookahead[3]};
     }
     // Absent before momentum_exchange_drift: its books start at the resume.
-    exchanged_impulse            = 0;
-    exchange_imbalance           = dealii::Tensor<1, dim>();
-    const auto exchange_position = in.tellg();
-    if (in >> text && text == "momentum_exchange")
-    {
-      in >> text;
-      exchanged_impulse = std::strtod(text.c_str(), nullptr);
-      for (unsigned int d = 0; d < dim; ++d)
-      {
-        in >> text;
-        exchange_imbalance[d] = std::strtod(text.c_str(), nullptr);
-      }
-    }
-    else
-    {
-      in.clear();
-      in.seekg(exchange_position);
-    }
+    const auto exchange = optional_line("momentum_exchange", 1 + dim);
+    exchanged_impulse   = exchange.empty() ? 0 : exchange[0];
+    for (unsigned int d = 0; d < dim; ++d)
+      exchange_imbalance[d] = exchange.empty() ? 0 : exchange[1 + d];
     statistics.load_values(in);
     AssertThrow(!in.bad(),
                 dealii::ExcMessage("Checkpoint: cannot read " + directory));

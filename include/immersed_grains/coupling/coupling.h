@@ -168,8 +168,8 @@ namespace ImmersedGrains
     /**
      * After a step's last grain (sub-)step: the sum of what the fluid owes
      * the grains (global, N s), after clearing it for grains that touched
-     * another or a wall in the step (a contact impulse, or one predicted):
-     * their mismatch is mostly the predicted contact impulse's error,
+     * another or a wall in the step (a contact impulse): their mismatch
+     * is mostly the predicted contact impulse's error,
      * which the relaxed prediction (Impulse prediction weight) carries
      * into the following steps; repaid at once as well, it brought back
      * the alternation that the prediction removes (doc/theory.md).
@@ -281,7 +281,8 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> predicted_impulse;
     // The drag the fluid's step assumed for each grain, beta (u - v) +
     // alpha grad p, with u the velocity it feels and v this
-    // (prepare_fluid_drag()), before the repayment of what it owed.
+    // (prepare_fluid_drag()), before the repayment of what it owed and
+    // without the predicted contact impulse (the prediction's to repay).
     std::vector<double>                 assumed_beta;
     std::vector<double>                 assumed_pressure_weight;
     std::vector<dealii::Tensor<1, dim>> assumed_velocity;
