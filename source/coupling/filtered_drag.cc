@@ -175,6 +175,7 @@ namespace ImmersedGrains
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
     const CellGather<dim>                            &gather,
     const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+    const bool                                        with_velocity,
     const F                                          &f) const
   {
     const auto &fluid_fe =
@@ -205,20 +206,23 @@ namespace ImmersedGrains
       const bool owned = gather.gather(cell, fluid_solution, local);
       Assert(owned, dealii::ExcInternalError());
       (void)owned;
-      for (unsigned int a = 0; a < dofs.velocity.size(); ++a)
-        for (unsigned int c = 0; c < dim; ++c)
-          velocity[c][a] = local[dofs.velocity[a][c]];
+      if (with_velocity)
+        for (unsigned int a = 0; a < dofs.velocity.size(); ++a)
+          for (unsigned int c = 0; c < dim; ++c)
+            velocity[c][a] = local[dofs.velocity[a][c]];
       for (unsigned int b = 0; b < dofs.pressure.size(); ++b)
         pressure[b] = local[dofs.pressure[b]];
-      velocity_shapes.reinit(cell, data.reference_points, false);
+      if (with_velocity)
+        velocity_shapes.reinit(cell, data.reference_points, false);
       pressure_shapes.reinit(cell, data.reference_points, true);
       filter_shapes.reinit(cell, data.reference_points, false);
       for (unsigned int q = 0; q < n_q; ++q)
       {
         data.JxW[q] =
           quadrature.weight(q) * pressure_shapes.jacobian_determinant(q);
-        for (unsigned int c = 0; c < dim; ++c)
-          data.velocity[q][c] = velocity_shapes.value_of(velocity[c], q);
+        if (with_velocity)
+          for (unsigned int c = 0; c < dim; ++c)
+            data.velocity[q][c] = velocity_shapes.value_of(velocity[c], q);
         data.pressure_gradient[q] = pressure_shapes.gradient_of(pressure, q);
       }
       data.filter_cell = filter.dof_cell(cell);
@@ -229,19 +233,23 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  FilteredDrag<dim>::filter_velocity(
+  FilteredDrag<dim>::filter_fluid(
     const dealii::DoFHandler<dim>                    &fluid_dof_handler,
     const CellGather<dim>                            &gather,
     const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+    const bool                                        with_velocity,
     const bool                                        with_pressure_gradient,
     const SolidScale                                 &solid_scale)
   {
+    if (!with_velocity && !with_pressure_gradient)
+      return;
     // (N_j, u) and (N_j, s grad p) in one pass over the cells.
     std::array<typename HelmholtzFilter<dim>::Vector, dim> velocity_rhs,
       pressure_rhs;
     for (unsigned int d = 0; d < dim; ++d)
     {
-      velocity_rhs[d] = filter.make_owned_vector();
+      if (with_velocity)
+        velocity_rhs[d] = filter.make_owned_vector();
       if (with_pressure_gradient)
         pressure_rhs[d] = filter.make_owned_vector();
     }
@@ -257,6 +265,7 @@ namespace ImmersedGrains
     for_each_cell(fluid_dof_handler,
                   gather,
                   fluid_solution,
+                  with_velocity,
                   [&](const auto &cell, const CellQuadrature &data)
                   {
                     const std::vector<double> scale =
@@ -277,8 +286,10 @@ namespace ImmersedGrains
                       {
                         const double weight =
                           data.filter_shapes->value(j, q) * data.JxW[q];
-                        for (unsigned int d = 0; d < dim; ++d)
-                          local_velocity[d](j) += data.velocity[q][d] * weight;
+                        if (with_velocity)
+                          for (unsigned int d = 0; d < dim; ++d)
+                            local_velocity[d](j) +=
+                              data.velocity[q][d] * weight;
                         if (with_pressure_gradient)
                           for (unsigned int d = 0; d < dim; ++d)
                             local_pressure[d](j) += grad_p[d] * weight;
@@ -286,10 +297,11 @@ namespace ImmersedGrains
                     }
                     for (unsigned int d = 0; d < dim; ++d)
                     {
-                      filter.add_cell_contribution(data.filter_cell,
-                                                   local_velocity[d],
-                                                   indices,
-                                                   velocity_rhs[d]);
+                      if (with_velocity)
+                        filter.add_cell_contribution(data.filter_cell,
+                                                     local_velocity[d],
+                                                     indices,
+                                                     velocity_rhs[d]);
                       if (with_pressure_gradient)
                         filter.add_cell_contribution(data.filter_cell,
                                                      local_pressure[d],
@@ -299,12 +311,13 @@ namespace ImmersedGrains
                   });
     std::vector<const typename HelmholtzFilter<dim>::Vector *> rhs;
     std::vector<typename HelmholtzFilter<dim>::Vector *>       fields;
-    for (unsigned int d = 0; d < dim; ++d)
-    {
-      velocity_rhs[d].compress(dealii::VectorOperation::add);
-      rhs.push_back(&velocity_rhs[d]);
-      fields.push_back(&velocity[d]);
-    }
+    if (with_velocity)
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        velocity_rhs[d].compress(dealii::VectorOperation::add);
+        rhs.push_back(&velocity_rhs[d]);
+        fields.push_back(&velocity[d]);
+      }
     if (with_pressure_gradient)
       for (unsigned int d = 0; d < dim; ++d)
       {
@@ -448,6 +461,7 @@ namespace ImmersedGrains
     for_each_cell(fluid_dof_handler,
                   gather,
                   fluid_solution,
+                  drag_as_field,
                   [&](const auto &cell, const CellQuadrature &data)
                   {
                     data.filter_cell->get_dof_indices(indices);

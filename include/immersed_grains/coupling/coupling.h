@@ -41,10 +41,11 @@ namespace ImmersedGrains
    *     gradient and of the solid flux (FilteredDrag);
    *  3. (the fluid solves with these)
    *  4. set_grain_forces(): the grains' hooks get -rho V_i g - V_i grad p
-   *     (new p), gamma_i and the fluid velocity they feel; their implicit
-   *     update v' = (m v + dt (m g + F + gamma u)) / (m + dt gamma) then
-   *     exchanges the momentum the fluid received (exactly with
-   *     Drag distribution = filtered; momentum_exchange_error).
+   *     (new p, filtered like the share the fluid took of it), gamma_i and
+   *     the fluid velocity they feel; their implicit update
+   *     v' = (m v + dt (m g + F + gamma u)) / (m + dt gamma) then
+   *     exchanges the momentum the fluid received (to round-off without
+   *     sub-steps; momentum_exchange_error).
    *  5. with Grain sub-steps, where the step would move grains too far,
    *     the grains take several steps through the frozen fluid, each after
    *     set_substep_grain_forces() re-evaluated their interaction force

@@ -70,17 +70,18 @@ namespace ImmersedGrains
              const typename dealii::Triangulation<dim>::active_cell_iterator &,
              std::vector<PointDrag<dim>> &)> &drags);
 
-    /** Filters the velocity (and, if @p with_pressure_gradient, the
-     * pressure gradient times @p solid_scale, the force per volume on the
-     * grains) of a Q2^dim-Q1 fluid solution, read cell by cell through
-     * @p gather (FluidSolver::get_cell_gather()). */
+    /** Filters the velocity (if @p with_velocity) and the pressure
+     * gradient times @p solid_scale, the force per volume on the grains
+     * (if @p with_pressure_gradient), of a Q2^dim-Q1 fluid solution, read
+     * cell by cell through @p gather (FluidSolver::get_cell_gather()). */
     void
-    filter_velocity(
+    filter_fluid(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
       const CellGather<dim>                            &gather,
       const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
-      bool              with_pressure_gradient = false,
-      const SolidScale &solid_scale            = SolidScale());
+      bool                                              with_velocity,
+      bool                                              with_pressure_gradient,
+      const SolidScale &solid_scale = SolidScale());
 
     /** The filtered velocity at points of a cell. */
     std::vector<dealii::Tensor<1, dim>>
@@ -140,13 +141,15 @@ namespace ImmersedGrains
     // Calls @p f(cell, quadrature) on each locally owned cell: the shape
     // functions through CellPointShapes (reference values kept across
     // cells) and the fluid's coefficients through @p gather, instead of two
-    // FEValues::reinit and a look-up in Epetra's map per DoF and cell.
+    // FEValues::reinit and a look-up in Epetra's map per DoF and cell. The
+    // velocity only @p with_velocity (its Q2 shapes cost most).
     template <typename F>
     void
     for_each_cell(
       const dealii::DoFHandler<dim>                    &fluid_dof_handler,
       const CellGather<dim>                            &gather,
       const dealii::TrilinosWrappers::MPI::BlockVector &fluid_solution,
+      bool                                              with_velocity,
       const F                                          &f) const;
 
     std::vector<dealii::Tensor<1, dim>>
