@@ -888,26 +888,60 @@ namespace ImmersedGrains
   }
 
 
-  template <int dim>
-  std::string
-  Simulation<dim>::saved_physics_description() const
+  namespace
   {
     // What decides the layout of the saved fields and grains: a run with
     // other physics would read them as something else (a frictionless
     // pile's 4 numbers per grain read as 7 gave grains at infinite speed).
-    std::string text = std::string("fluid ") +
-                       (fluid_parameters.enabled ? "on" : "off") + ", grains ";
-    if (!grain_parameters.enabled)
-      return text + "off";
-    const GrainPropertyLayout layout =
-      make_grain_property_layout(grain_parameters,
-                                 fluid_parameters.enabled,
-                                 follows_straight_paths());
-    text += "with " + std::to_string(layout.n_properties) + " properties (";
-    for (unsigned int k = 0; k < layout.names.size(); ++k)
-      if (k == 0 || layout.names[k] != layout.names[k - 1])
-        text += (k == 0 ? "" : ", ") + layout.names[k];
-    return text + ")";
+    template <int dim>
+    std::string
+    physics_description(const bool                  fluid,
+                        const GrainParameters<dim> &grains,
+                        const bool                  straight_paths)
+    {
+      std::string text =
+        std::string("fluid ") + (fluid ? "on" : "off") + ", grains ";
+      if (!grains.enabled)
+        return text + "off";
+      const GrainPropertyLayout layout =
+        make_grain_property_layout(grains, fluid, straight_paths);
+      text += "with " + std::to_string(layout.n_properties) + " properties (";
+      for (unsigned int k = 0; k < layout.names.size(); ++k)
+        if (k == 0 || layout.names[k] != layout.names[k - 1])
+          text += (k == 0 ? "" : ", ") + layout.names[k];
+      return text + ")";
+    }
+  } // namespace
+
+
+  template <int dim>
+  std::string
+  Simulation<dim>::saved_physics_description() const
+  {
+    return physics_description(fluid_parameters.enabled,
+                               grain_parameters,
+                               follows_straight_paths());
+  }
+
+
+  template <int dim>
+  bool
+  Simulation<dim>::physics_reachable(const std::string &saved) const
+  {
+    // Every combination of the settings that decide the layout.
+    for (unsigned int k = 0; k < 64; ++k)
+    {
+      GrainParameters<dim> grains = grain_parameters;
+      grains.enabled              = k & 1;
+      grains.contacts_enabled     = k & 2;
+      grains.contact.friction     = (k & 4) ? 1.0 : 0.0;
+      grains.has_fixed_region     = k & 8;
+      const bool fluid            = k & 16;
+      const bool straight_paths   = k & 32;
+      if (physics_description(fluid, grains, straight_paths) == saved)
+        return true;
+    }
+    return false;
   }
 
 
@@ -936,6 +970,17 @@ namespace ImmersedGrains
       return;
     }
     const std::string wanted = saved_physics_description();
+    if (saved != wanted && !physics_reachable(saved))
+      InputLocation{parameter_file, "Checkpoint"}.fail(
+        "Resume",
+        checkpoint_parameters.resume == Checkpoint::Resume::always ? "true" :
+                                                                     "auto",
+        directory + " was written with " + saved +
+          ", a layout no setting of this version gives (this version's, "
+          "for this scene: " +
+          wanted +
+          "): it was written by another version of immersed-grains; resume "
+          "it with that version, or start afresh with Resume = false");
     if (saved != wanted)
       InputLocation{parameter_file, "Checkpoint"}.fail(
         "Resume",

@@ -99,6 +99,12 @@ namespace ImmersedGrains
     // resume with other physics stops with an input error.
     std::string
     saved_physics_description() const;
+    // Whether some choice of the settings that decide the saved layout
+    // (Fluid/Enabled, Grains/Enabled, contacts, friction, a fixed region,
+    // straight paths) gives @p saved: if none does, another version of
+    // the code wrote it.
+    bool
+    physics_reachable(const std::string &saved) const;
     void
     check_saved_physics(const std::string &directory) const;
     // Refines and coarsens the mesh by the Adaptivity criteria and moves
