@@ -679,7 +679,7 @@ namespace ImmersedGrains
     // into alpha_h grad p and k_h grad p: spread by the filter, so the
     // gradient they take is its adjoint, filtered with every distribution
     // (sum_i V_i theta_i grad p_i = (alpha_h, grad p)). Taken at their
-    // centres, a cell spread's exchange drifted by 2-4 % in 2D clouds.
+    // centres, the books of a 2D cloud with the cell spread drifted by 2 %.
     // A later sub-step sees the same fluid: its filtered fields stand.
     if (as_predicted && (drag_as_field() || implicit_velocity))
       filtered_drag->filter_fluid(fluid.get_dof_handler(),
