@@ -204,8 +204,8 @@ namespace ImmersedGrains
     // on clouds of 321 discs (cloud_single_fluid_2d) and on lattices. A
     // filter half the box wide, which puts separate discs right, takes a
     // ball's collective flow away whatever its size (a ball of 11 discs
-    // fell 27 times too slowly), so a small ball keeps the cell spread
-    // and is told its error.
+    // fell 27 times slower than with the cell spread), so a small ball keeps
+    // the cell spread and is told its error.
     const bool ball_2d   = grain_parameters.shape == PlacementShape::ball;
     const bool cloud_2d  = ball_2d && placed_grains >= 100;
     const auto disc_word = [](const unsigned int n)

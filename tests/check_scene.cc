@@ -10,8 +10,9 @@
 // default coupling (Drag distribution = auto): a ball of one disc (the
 // cell spread, as for a cloud, and a warning: a lone disc settles several
 // times too fast), a cloud of 160 discs (the cell spread, validated on 2D
-// clouds: none) and 160 discs in a box (a suspension: the filtered drag
-// with a filter half the box wide, none).
+// clouds: none), the same cloud given the filtered drag (a warning: the
+// filter smooths the ball's collective flow) and 160 discs in a box (a
+// suspension: the filtered drag with a filter half the box wide, none).
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -106,5 +107,11 @@ main()
   // A 2D cloud at area fraction 0.28: 160 of the discs' area over the
   // ball's.
   check("cloud_2d", "", false, 160, 2);
+  check("cloud_2d_filtered",
+        "  set Drag distribution = filtered\n"
+        "  set Smoothing length = 1e-4\n",
+        false,
+        160,
+        2);
   check("suspension_2d", "", false, 160, 2, true);
 }
