@@ -35,6 +35,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -110,20 +111,31 @@ main(int argc, char **argv)
   const std::string    friction_error =
     resume_error("resumed", "subsection Contacts\n  set Friction = 0.3\nend\n");
 
+  // A copy of the run's checkpoint sets in @p name, each set's
+  // physics.txt handed to @p edit (on rank 0).
+  const auto copy_sets =
+    [root](const std::string                                        &name,
+           const std::function<void(const std::filesystem::path &)> &edit)
+  {
+    if (root)
+    {
+      std::filesystem::remove_all(name);
+      std::filesystem::copy("resumed",
+                            name,
+                            std::filesystem::copy_options::recursive);
+      for (const auto &set :
+           std::filesystem::directory_iterator(name + "/checkpoints"))
+        edit(set.path() / "physics.txt");
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+  };
+
   // Sets written before physics.txt existed are resumed without the check,
   // but never with the band's lookahead: their grains carry no straight
   // paths. (The same run's sets with the file taken away.)
-  if (root)
-  {
-    std::filesystem::remove_all("unlabelled");
-    std::filesystem::copy("resumed",
-                          "unlabelled",
-                          std::filesystem::copy_options::recursive);
-    for (const auto &set :
-         std::filesystem::directory_iterator("unlabelled/checkpoints"))
-      std::filesystem::remove(set.path() / "physics.txt");
-  }
-  MPI_Barrier(MPI_COMM_WORLD);
+  copy_sets("unlabelled",
+            [](const std::filesystem::path &file)
+            { std::filesystem::remove(file); });
   const std::string unlabelled_error =
     resume_error("unlabelled",
                  "subsection Adaptivity\n  set Every steps = auto\nend\n");
@@ -132,27 +144,18 @@ main(int argc, char **argv)
   // gives, as another version of the code writes (the same sets without
   // the property exchange_owed, which versions before it lacked): the
   // error says so, instead of listing settings that cannot help.
-  if (root)
-  {
-    std::filesystem::remove_all("foreign");
-    std::filesystem::copy("resumed",
-                          "foreign",
-                          std::filesystem::copy_options::recursive);
-    for (const auto &set :
-         std::filesystem::directory_iterator("foreign/checkpoints"))
-    {
-      const auto    file = set.path() / "physics.txt";
-      std::ifstream in(file);
-      std::string   line;
-      std::getline(in, line);
-      in.close();
-      const std::string owed = ", exchange_owed";
-      if (line.find(owed) != std::string::npos)
-        line.erase(line.find(owed), owed.size());
-      std::ofstream(file) << line << '\n';
-    }
-  }
-  MPI_Barrier(MPI_COMM_WORLD);
+  copy_sets("foreign",
+            [](const std::filesystem::path &file)
+            {
+              std::ifstream in(file);
+              std::string   line;
+              std::getline(in, line);
+              in.close();
+              const std::string owed = ", exchange_owed";
+              if (line.find(owed) != std::string::npos)
+                line.erase(line.find(owed), owed.size());
+              std::ofstream(file) << line << '\n';
+            });
   const std::string foreign_error = resume_error("foreign", "");
 
   // A run straight to step 10, and one stopped after step 5 and resumed

@@ -2,9 +2,10 @@
 """Small 2D balls of discs: which drag distribution suits them
 (doc/validation.md, "Small 2D balls").
 
-The main scene (prm/falling_cloud_2d.prm: glass discs of r = 12.5 um in a
-water-glycerol mixture, solid fraction 0.2, a 16 x 30 mm box, adaptive
-cells down to 0.125 mm = 5 disc diameters) with balls of N = 10, 30, 100
+The main scene, made from prm/falling_cloud_2d.prm (glass discs of
+r = 12.5 um in a water-glycerol mixture, solid fraction 0.2, a 16 x 30 mm
+box, adaptive cells down to 0.125 mm = 5 disc diameters), with balls of
+N = 10, 30, 100
 and 321 discs (radius r sqrt(5 N)), and a lone disc, each run to
 t = 0.1 s with
 
@@ -32,6 +33,7 @@ About two minutes on one core.
 import argparse
 import math
 import os
+import re
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -40,68 +42,44 @@ import scene_runner  # noqa: E402
 
 R_DISC = 12.5e-6
 BALLS = [10, 30, 100, 321]
-SCENE = """set Dimension = 2
-set End time  = {end}
-set Time step = 0.002
-set Adaptive time step = true
-set Courant number = 0.1
-subsection Mesh
-  set Lower corner        = 0, 0
-  set Upper corner        = 16e-3, 30e-3
-  set Subdivisions        = 8, 15
-  set Initial refinement  = 0
-  set Boundary conditions = wall, wall, wall, wall
-end
-subsection Adaptivity
-  set Enabled   = true
-  set Min level = 0
-  set Max level = {level}
-end
-subsection Fluid
-  set Density   = 1154
-  set Viscosity = 0.0108
-  set Advection = true
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 12.5e-6
-  set Density = 2400
-  subsection Placement
-{placement}
-  end
-end
-subsection Coupling
-  set Drag distribution = {distribution}
-  set Smoothing length  = {length}
-end
-subsection Gravity
-  set Vector = 0, -9.81
-end
-subsection Output
-  set Write fields every = 0
-end
-"""
+SCENE = os.path.join(scene_runner.ROOT, "prm", "falling_cloud_2d.prm")
 
 
 def placement(n):
     if n == 1:
         return ("    set Shape     = list\n"
-                "    set Positions = 8e-3, 25e-3")
+                "    set Positions = 8e-3, 25e-3\n")
     return ("    set Shape          = ball\n"
             "    set Center         = 8e-3, 25e-3\n"
             f"    set Size           = {R_DISC * math.sqrt(5 * n):.6e}\n"
             "    set Solid fraction = 0.2\n"
-            "    set Random seed    = 1")
+            "    set Random seed    = 1\n")
+
+
+def scene(n, distribution, length, level, end):
+    """The main scene with the ball of @p n discs (a lone disc for 1)."""
+    text = open(SCENE).read()
+    changes = [(r"set End time  = 1\n", f"set End time  = {end}\n"),
+               (r"set Max level = 4\n", f"set Max level = {level}\n"),
+               (r"    set Shape          = ball\n(    set .*\n){4}",
+                placement(n)),
+               (r"set Smoothing length = 1e-4\n",
+                f"set Smoothing length = {length}\n"
+                f"  set Drag distribution = {distribution}\n"),
+               (r"set Write fields every = 20\n",
+                "set Write fields every = 0\n")]
+    for pattern, replacement in changes:
+        text, count = re.subn(pattern, lambda _: replacement, text)
+        assert count == 1, "the scene changed: %s" % pattern
+    return text
 
 
 def velocity(n, distribution, level, out, end, length=None):
     if length is None:
         length = 8e-3 if distribution == "filtered" else 1e-4
     name = f"n{n}_{distribution}_{length:g}_L{level}"
-    rows = scene_runner.run_scene(
-        SCENE.format(end=end, level=level, placement=placement(n),
-                     distribution=distribution, length=length),
-        os.path.join(out, name))
+    rows = scene_runner.run_scene(scene(n, distribution, length, level, end),
+                                  os.path.join(out, name))
     last = rows[-1]
     column = "cloud_velocity_y" if n > 1 else "mean_velocity_y"
     return -float(last[column]), int(float(last["particles"]))
