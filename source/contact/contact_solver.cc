@@ -177,17 +177,45 @@ namespace ImmersedGrains
         // The overlap is only worth a pass over the contacts once the
         // impulses have settled.
         double overlap = 0;
+        // A subspace correction after every interval sweeps, and one when
+        // the sweeps' test is passed before any has run. The step is solved
+        // once the last correction found (almost) nothing left to lower
+        // (settled_by()) and a sweep after it passes the test, so that what
+        // the correction moved is seen by the sweeps' test too.
+        const unsigned int interval        = parameters.subspace_interval;
+        unsigned int       last_correction = 0;
+        bool               corrected = false, settled = (interval == 0);
+        const auto         correct = [&]()
+        {
+          last_correction = result.iterations;
+          corrected       = true;
+          const double share =
+            subspace_correction([]() {}, [](double *, unsigned int) {});
+          settled = settled_by(share);
+          return share;
+        };
         while (!result.converged &&
                result.iterations < parameters.max_iterations)
         {
+          if (interval > 0 && result.iterations >= last_correction + interval)
+            correct();
           const SweepResult s = sweep();
           ++result.iterations;
           result.residual =
             (s.max_impulse > 0 ? s.max_change / s.max_impulse : 0.);
           if (s.max_change <= parameters.tolerance * s.max_impulse)
           {
-            overlap          = predicted_max_overlap();
-            result.converged = converged(s, overlap);
+            if (!settled && !corrected)
+            {
+              correct();
+              if (!settled)
+                continue;
+            }
+            if (settled)
+            {
+              overlap          = predicted_max_overlap();
+              result.converged = converged(s, overlap);
+            }
           }
         }
         result.max_overlap =
@@ -868,6 +896,15 @@ namespace ImmersedGrains
     {
       return s.max_change <= parameters.tolerance * s.max_impulse &&
              max_overlap <= allowed_overlap();
+    }
+
+
+
+    template <int dim>
+    bool
+    ContactSolver<dim>::settled_by(const double energy_share) const
+    {
+      return energy_share <= parameters.tolerance * parameters.tolerance;
     }
 
 

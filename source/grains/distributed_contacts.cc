@@ -506,8 +506,33 @@ namespace ImmersedGrains
         };
         return solver.iterate_accelerated([&]() { glue_copies(); }, reduce);
       }
+      const auto sum = [&](double *values, const unsigned int n)
+      {
+        if (n_ranks == 1)
+          return;
+        std::vector<double> local(values, values + n);
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(local),
+                                    comm,
+                                    dealii::ArrayView<double>(values, n));
+      };
+      // Subspace corrections as in ContactSolver::solve(); the copies are
+      // glued where they run, as they need.
+      const unsigned int interval        = prm.subspace_interval;
+      unsigned int       last_correction = 0;
+      bool               corrected = false, settled = (interval == 0);
+      const auto         correct = [&]()
+      {
+        last_correction = result.iterations;
+        corrected       = true;
+        const double share =
+          solver.subspace_correction([&]() { glue_copies(); }, sum);
+        settled = solver.settled_by(share);
+        return share;
+      };
       while (!result.converged && result.iterations < prm.max_iterations)
       {
+        if (interval > 0 && result.iterations >= last_correction + interval)
+          correct();
         // Several local sweeps per exchange: on a rank boundary information
         // then crosses once per batch, but the messages and the reduction,
         // whose latency dominates on loaded machines, are paid once.
@@ -536,8 +561,18 @@ namespace ImmersedGrains
         }
         result.residual = s.max_impulse > 0 ? s.max_change / s.max_impulse : 0;
         if (s.max_change <= prm.tolerance * s.max_impulse)
-          result.converged = dealii::Utilities::MPI::min(
-            int(solver.converged(s, solver.predicted_max_overlap())), comm);
+        {
+          // s is the same on every rank, so all correct together.
+          if (!settled && !corrected)
+          {
+            correct();
+            if (!settled)
+              continue;
+          }
+          if (settled)
+            result.converged = dealii::Utilities::MPI::min(
+              int(solver.converged(s, solver.predicted_max_overlap())), comm);
+        }
       }
       result.max_overlap = solver.predicted_max_overlap();
       return result;

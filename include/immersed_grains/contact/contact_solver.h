@@ -105,6 +105,14 @@ namespace ImmersedGrains
 
       /// Start from last step's impulses, matched by grain ids.
       bool warm_start = true;
+
+      /// Gauss-Seidel: a subspace correction
+      /// (ContactSolver::subspace_correction()) after every this many
+      /// sweeps of a step that has not converged; 0 switches it off.
+      unsigned int subspace_interval = 0;
+
+      /// Conjugate-gradient iterations of one subspace correction.
+      unsigned int subspace_iterations = 50;
     };
 
     /// Local measures of one Gauss-Seidel sweep (reduce with max over ranks).
@@ -224,6 +232,43 @@ namespace ImmersedGrains
       SweepResult
       sweep();
 
+      /**
+       * A subspace correction between Gauss-Seidel sweeps (without
+       * friction; with friction only in the position correction): on the
+       * contacts that carry an impulse, subspace_iterations steps of
+       * Jacobi-preconditioned conjugate gradients towards the impulses that
+       * would make each of them hold exactly (N_AA d = -(u_n - ubar)_A), then
+       * a step along that direction, projected onto p_n >= 0, that lowers
+       * the step's quadratic energy (halved until it does). Gauss-Seidel
+       * reduces an error by less the smaller its share of N, and a
+       * frictionless packing near its isostatic point has many such
+       * errors, spread over the grains (doc/contacts.md); conjugate
+       * gradients reach them in the square root of the iterations. The
+       * sweeps decide which contacts carry an impulse, the correction
+       * solves on them.
+       *
+       * Returns by how much the step lowers f, as a share of 1/2 p.D p
+       * on the subspace (D = diag N, so that this is the energy the
+       * impulses would carry each alone); 0 if it found no step that
+       * lowers f. f less its minimum is the kinetic energy of the error in
+       * the velocities (1/2 e.N e for an impulse error e), which the
+       * sweeps' own test does not see where N is small: solve() therefore
+       * also asks for a correction that finds a share below the tolerance
+       * squared (settled_by()). Such a correction only tests: the step is
+       * not taken, so that on a bed at rest the conjugate-gradient
+       * polynomial, which may grow a component it does not see, does not
+       * act step after step. A step taken must be followed by a sweep
+       * that passes the sweeps' test. Reads and changes the
+       * working velocities, so a distributed caller calls it with the
+       * copies glued, and passes @p glue (as for iterate_accelerated()) and
+       * @p sum, which must add its values over all ranks in place; every
+       * rank must call it together.
+       */
+      double
+      subspace_correction(
+        const std::function<void()>                       &glue,
+        const std::function<void(double *, unsigned int)> &sum);
+
       /// Largest -(g + dt u_n) over the contacts, with the current
       /// velocities and the gap g of the current phase: while solving for
       /// the velocities, the overlap the step adds to what it started with
@@ -255,6 +300,12 @@ namespace ImmersedGrains
 
       bool
       converged(const SweepResult &sweep, const double max_overlap) const;
+
+      /// Whether a subspace_correction() that lowered f by @p energy_share
+      /// (its result) leaves the step solved: below the tolerance squared,
+      /// the share that the sweeps' test allows one impulse.
+      bool
+      settled_by(const double energy_share) const;
 
       /**
        * The APGD iterations (ContactMethod::apgd) after setup(): each
@@ -393,6 +444,22 @@ namespace ImmersedGrains
 
       ContactImpulses<dim> pair_results;
       ContactImpulses<dim> wall_results;
+
+      // Subspace correction (source/contact/subspace_correction.cc): the
+      // rows of the subspace, and per row the gradient u_n - ubar, the
+      // conjugate-gradient vectors and the impulses before the step.
+      std::vector<unsigned int> subspace_rows;
+      std::vector<double>       subspace_inverse_w, subspace_gradient,
+        subspace_solution, subspace_residual, subspace_search, subspace_image,
+        subspace_p_n;
+      std::vector<GrainSlot> subspace_velocities;
+
+      /// N d on the subspace: the working velocities are set to M^-1 H d
+      /// alone, glued, read back as u_n, and restored.
+      void
+      apply_delassus(const std::vector<double>   &d,
+                     std::vector<double>         &image,
+                     const std::function<void()> &glue);
 
       /// u_n = (v_j - v_i).n with the working velocities.
       double
