@@ -176,28 +176,18 @@ namespace ImmersedGrains
           result.converged = true;
         // The overlap is only worth a pass over the contacts once the
         // impulses have settled.
-        double overlap = 0;
-        // A subspace correction after every interval sweeps, and one when
-        // the sweeps' test is passed before any has run. The step is solved
-        // once the last correction found (almost) nothing left to lower
-        // (settled_by()) and a sweep after it passes the test, so that what
-        // the correction moved is seen by the sweeps' test too.
-        const unsigned int interval        = parameters.subspace_interval;
-        unsigned int       last_correction = 0;
-        bool               corrected = false, settled = (interval == 0);
-        const auto         correct = [&]()
+        double           overlap = 0;
+        SubspaceSchedule schedule(parameters.subspace_interval);
+        const auto       correct = [&]()
         {
-          last_correction = result.iterations;
-          corrected       = true;
-          const double share =
-            subspace_correction([]() {}, [](double *, unsigned int) {});
-          settled = settled_by(share);
-          return share;
+          schedule.record(result.iterations,
+                          settled_by(subspace_correction(
+                            []() {}, [](double *, unsigned int) {})));
         };
         while (!result.converged &&
                result.iterations < parameters.max_iterations)
         {
-          if (interval > 0 && result.iterations >= last_correction + interval)
+          if (schedule.due(result.iterations))
             correct();
           const SweepResult s = sweep();
           ++result.iterations;
@@ -205,13 +195,13 @@ namespace ImmersedGrains
             (s.max_impulse > 0 ? s.max_change / s.max_impulse : 0.);
           if (s.max_change <= parameters.tolerance * s.max_impulse)
           {
-            if (!settled && !corrected)
+            if (schedule.confirm())
             {
               correct();
-              if (!settled)
+              if (!schedule.settled)
                 continue;
             }
-            if (settled)
+            if (schedule.settled)
             {
               overlap          = predicted_max_overlap();
               result.converged = converged(s, overlap);

@@ -517,21 +517,16 @@ namespace ImmersedGrains
       };
       // Subspace corrections as in ContactSolver::solve(); the copies are
       // glued where they run, as they need.
-      const unsigned int interval        = prm.subspace_interval;
-      unsigned int       last_correction = 0;
-      bool               corrected = false, settled = (interval == 0);
-      const auto         correct = [&]()
+      Contact::SubspaceSchedule schedule(prm.subspace_interval);
+      const auto                correct = [&]()
       {
-        last_correction = result.iterations;
-        corrected       = true;
-        const double share =
-          solver.subspace_correction([&]() { glue_copies(); }, sum);
-        settled = solver.settled_by(share);
-        return share;
+        schedule.record(result.iterations,
+                        solver.settled_by(solver.subspace_correction(
+                          [&]() { glue_copies(); }, sum)));
       };
       while (!result.converged && result.iterations < prm.max_iterations)
       {
-        if (interval > 0 && result.iterations >= last_correction + interval)
+        if (schedule.due(result.iterations))
           correct();
         // Several local sweeps per exchange: on a rank boundary information
         // then crosses once per batch, but the messages and the reduction,
@@ -563,13 +558,13 @@ namespace ImmersedGrains
         if (s.max_change <= prm.tolerance * s.max_impulse)
         {
           // s is the same on every rank, so all correct together.
-          if (!settled && !corrected)
+          if (schedule.confirm())
           {
             correct();
-            if (!settled)
+            if (!schedule.settled)
               continue;
           }
-          if (settled)
+          if (schedule.settled)
             result.converged = dealii::Utilities::MPI::min(
               int(solver.converged(s, solver.predicted_max_overlap())), comm);
         }

@@ -115,6 +115,53 @@ namespace ImmersedGrains
       unsigned int subspace_iterations = 50;
     };
 
+    /**
+     * When the Gauss-Seidel iterations run subspace corrections
+     * (ContactSolver::subspace_correction()), in ContactSolver::solve() and
+     * in a distributed caller alike: after every interval sweeps, and once
+     * when the sweeps' test is passed before any has run. A step is solved
+     * when the sweeps' test is passed and the last correction found
+     * (almost) nothing left to lower (ContactSolver::settled_by(); such a
+     * correction only tests and moves nothing).
+     */
+    struct SubspaceSchedule
+    {
+      explicit SubspaceSchedule(const unsigned int interval)
+          : interval(interval)
+          , settled(interval == 0)
+      {
+      }
+
+      /// Whether a correction is due before the next sweep.
+      bool
+      due(const unsigned int iterations) const
+      {
+        return interval > 0 && iterations >= last + interval;
+      }
+
+      /// Whether the sweeps' test, just passed, calls for a correction
+      /// to confirm it.
+      bool
+      confirm() const
+      {
+        return !settled && !corrected;
+      }
+
+      /// Records a correction after @p iterations sweeps.
+      void
+      record(const unsigned int iterations, const bool settled_now)
+      {
+        last      = iterations;
+        corrected = true;
+        settled   = settled_now;
+      }
+
+      const unsigned int interval;
+      unsigned int       last      = 0;
+      bool               corrected = false;
+      bool               settled;
+    };
+
     /// Local measures of one Gauss-Seidel sweep (reduce with max over ranks).
     struct SweepResult
     {
