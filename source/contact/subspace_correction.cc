@@ -167,6 +167,10 @@ namespace ImmersedGrains
       if (!(along[1] > 0) || !(along[0] < 0))
         return 0;
       double step = -along[0] / along[1];
+      // What the step would lower f by without the projection: what a
+      // correction reports where no projected step lowers f, so that a
+      // step is not called solved for want of a step.
+      const double predicted = 0.5 * step * -along[0] / scale;
 
       // Projected onto p >= 0 the step may raise f; halve it until f falls.
       // f changes by grad f.dp + 1/2 dp.N dp, and N dp is the change of the
@@ -222,7 +226,7 @@ namespace ImmersedGrains
         for (unsigned int q = 0; q < n; ++q)
           rows[subspace_rows[q]].p_n = subspace_p_n[q];
       }
-      return 0;
+      return predicted;
     }
 
 

@@ -296,13 +296,15 @@ namespace ImmersedGrains
        *
        * Returns by how much the step lowers f, as a share of 1/2 p.D p
        * on the subspace (D = diag N, so that this is the energy the
-       * impulses would carry each alone); 0 if it found no step that
-       * lowers f. f less its minimum is the kinetic energy of the error in
-       * the velocities (1/2 e.N e for an impulse error e), which the
-       * sweeps' own test does not see where N is small: solve() therefore
-       * also asks for a correction that finds a share below the tolerance
-       * squared (settled_by()). Such a correction only tests: the step is
-       * not taken, so that on a bed at rest the conjugate-gradient
+       * impulses would carry each alone); 0 where the gradient on the
+       * subspace vanishes; where no projected step lowers f, the share the
+       * unprojected step would take, so that the test below does not call
+       * a step solved for want of a step. f less its minimum is the kinetic
+       * energy of the error in the velocities (1/2 e.N e for an impulse error
+       * e), which the sweeps' own test does not see where N is small: solve()
+       * therefore also asks for a correction that finds a share below the
+       * tolerance squared (settled_by()). Such a correction only tests: the
+       * step is not taken, so that on a bed at rest the conjugate-gradient
        * polynomial, which may grow a component it does not see, does not
        * act step after step. A step taken must be followed by a sweep
        * that passes the sweeps' test. Reads and changes the
