@@ -109,10 +109,10 @@ namespace ImmersedGrains
       /// Gauss-Seidel: a subspace correction
       /// (ContactSolver::subspace_correction()) after every this many
       /// sweeps of a step that has not converged; 0 switches it off.
-      unsigned int subspace_interval = 0;
+      unsigned int subspace_interval = 20;
 
       /// Conjugate-gradient iterations of one subspace correction.
-      unsigned int subspace_iterations = 50;
+      unsigned int subspace_iterations = 200;
     };
 
     /**
