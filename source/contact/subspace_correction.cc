@@ -208,11 +208,9 @@ namespace ImmersedGrains
         }
         sum(change, 2);
         const double share = -(change[0] + 0.5 * change[1]) / scale;
-        // A correction that finds (almost) nothing left only tests: taken,
-        // its conjugate-gradient polynomial, which may grow a component
-        // that it does not see, would act on a bed at rest step after step
-        // (the 42 discs of tests/grains_fixed_region.prm, at rest at
-        // 1e-29 J, gained tenfold every 50 steps).
+        // A correction that finds (almost) nothing left only tests: the
+        // step is solved to the tolerance, and a step taken would need
+        // another sweep to confirm it.
         if (share > 0 && !settled_by(share))
           return share;
         if (share > 0)

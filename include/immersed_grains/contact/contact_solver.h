@@ -304,12 +304,11 @@ namespace ImmersedGrains
        * e), which the sweeps' own test does not see where N is small: solve()
        * therefore also asks for a correction that finds a share below the
        * tolerance squared (settled_by()). Such a correction only tests: the
-       * step is not taken, so that on a bed at rest the conjugate-gradient
-       * polynomial, which may grow a component it does not see, does not
-       * act step after step. A step taken must be followed by a sweep
-       * that passes the sweeps' test. Reads and changes the
-       * working velocities, so a distributed caller calls it with the
-       * copies glued, and passes @p glue (as for iterate_accelerated()) and
+       * step is not taken, as the step is solved to the tolerance. A step
+       * taken must be followed by a sweep that passes the sweeps' test. Reads
+       * and changes the working velocities, so a distributed caller calls it
+       * with the copies glued, and passes @p glue (as for
+       * iterate_accelerated()) and
        * @p sum, which must add its values over all ranks in place; every
        * rank must call it together.
        */
