@@ -4,7 +4,7 @@
 #     time steps, drag and a jumping fluid fraction (2D levels 3..7, 3D 2..4),
 #     with the default `Drag coefficient averaging = jump` (cell means in the
 #     cells the jump cuts), with the drag at the quadrature points
-#     (`quadrature`, the default before) and with the same physical drag on
+#     (`quadrature`) and with the same physical drag on
 #     every level (FIXED=1); LARGE=1 adds 3D level 5 (several GiB);
 #     INNER=1 the inner-GMRES variant;
 #  2. what switching physics off saves: the same scene solved as

@@ -1,5 +1,5 @@
-// Evaluates a matrix-free path for the fluid's velocity block (issue 13,
-// doc/performance.md "A matrix-free velocity block"): the same operator
+// Evaluates a matrix-free path for the fluid's velocity block
+// (doc/performance.md "A matrix-free velocity block"): the same operator
 //
 //   A u = (c u, v) + (nu grad u, grad v),   c = rho a0/dt + beta(x),
 //

@@ -134,7 +134,7 @@ def study(strategies, scene, work, figure, title, default_end, options=(),
     saved = os.path.join(args.out, "results.json")
     if args.plot_only:
         results = json.load(open(saved))
-        for r in results:  # written before the 3D study shared this code
+        for r in results:  # results files without centroid fields: the 2D layout
             if "centroid" not in r:
                 r.update(start=[r["x"], r["y0"]], centroid=[r["x"], r["y"]],
                          grains=321)
