@@ -3,9 +3,10 @@
 // square, no drag outside, a swirling body force, Stokes with dt = 1 and
 // steady. With `Drag coefficient averaging = cell`, and with the default
 // `jump` (cell means only in the cells the jump cuts), FGMRES must converge
-// within 30 iterations (the goal) at levels 4 and 5 (the
-// quadrature-point drag needs up to 181 at level 5, doc/benchmarks.md; the
-// default solver measures 12-25 there); the test prints whether it did,
+// within 30 iterations (the bound doc/benchmarks.md, section 1, holds the
+// block preconditioner to) at levels 4 and 5 (the quadrature-point drag
+// needs up to 181 at level 5, doc/benchmarks.md, "The drag-jump cells";
+// the default solver measures 12-25 there); the test prints whether it did,
 // not the counts, which vary a
 // little between Trilinos versions. It also prints how many cells had their
 // drag averaged: every cell with 'cell'; with 'jump' exactly the cells that
@@ -19,8 +20,9 @@
 // converge within 24 iterations on one rank and on two: the Schur
 // complement approximation is then the pressure mass matrix alone, and its
 // inverse must not depend on the partition (measured 18-21 on one rank and
-// on two; with a single block-Jacobi ILU two ranks needed 28 and 32,
-// doc/benchmarks.md, sixth round).
+// on two; applied as a single block-Jacobi ILU it does, and two ranks take
+// 28 and 32; doc/performance.md, "Solver settings and what they cost",
+// `Pressure mass tolerance`).
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/distributed/tria.h>
@@ -155,9 +157,9 @@ main(int argc, char **argv)
                       result.n_cells);
       }
   // The finest level, steady, where the Stokes-Darcy interface is hardest
-  // for the Schur complement approximation: within the 30 (measured
-  // 23-24 on one rank and on two; 33 before the pressure mass matrix was
-  // lightened in the drag cells, doc/benchmarks.md, seventh round).
+  // for the Schur complement approximation: within 30 (measured 23-24 on
+  // one rank and on two; 33 without the pressure mass matrix's weight
+  // lightened in the drag cells, doc/benchmarks.md, section 1).
   for (const double beta_scaled : {1e4, 1e8})
   {
     const bool converged = solve_ball("", 7, 0.0, beta_scaled, 30).converged;
