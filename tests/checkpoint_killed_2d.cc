@@ -13,6 +13,8 @@
 // - its statistics.csv has every step 0-10 once, and every column but
 //   wall_time equals the straight run's to the last digit.
 // Both runs are separate processes of the executable, as a user's are.
+// The reference is the code's own straight run: a resumed run must
+// reproduce it exactly, so no independent value enters.
 //
 // Wall time interval: a run of 4 steps with Every steps = 0 and an
 // interval of a microsecond saves after every step (and keeps the two

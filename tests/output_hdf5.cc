@@ -6,7 +6,8 @@
 // with their times; every file it names exists and is an HDF5 file (its
 // signature); the grains' list has one vertex per grain; and the resumed
 // run's lists are the straight run's, character for character (the XDMF
-// grids written before the checkpoint travel with it).
+// grids written before the checkpoint travel with it): the reference for
+// the restart is the code's own straight run.
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 
