@@ -5,7 +5,8 @@
 //
 // Statics (doc/references.md, "Resting column"): the contact under grain
 // j from the top carries j m g (1 - rho/rho_p); checked at every step to
-// 1e-8 relative. The gap term keeps the column where it is: what the
+// 1e-8 relative, four orders above the solve's tolerance (1e-12). The gap
+// term keeps the column where it is: what the
 // solver leaves unconverged (relative impulse change 1e-12 per sweep)
 // moves a grain by about 1e-13 r within a step and the next step takes it
 // back, so the drift stays below 1e-11 r over the run instead of adding

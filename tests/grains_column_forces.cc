@@ -3,7 +3,9 @@
 // velocities, distributed contact solve, position update, sort), 2D and
 // 3D. Statics (doc/references.md, "Resting column"): the contact under
 // grain j from the top carries j m g; checked for every contact at every
-// step to 1e-8 relative, and nothing may drift (centre heights to 1e-11 r).
+// step to 1e-8 relative (four orders above the contact solve's tolerance,
+// 1e-12, as in contact_resting_column), and nothing may drift (centre
+// heights to 1e-11 r).
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/mpi.h>
