@@ -3,7 +3,7 @@
 // the failed step to look at: no backtrace, no hang, no run that goes on
 // with NaN. The scene's forcing turns to 0/0 from t = 4.5 ms on, so the
 // fifth step's linear system holds NaN (the solver sees it first; the
-// per-step finite check, source/simulation.cc, backs it up for what no
+// per-step finite check, source/divergence_guard.cc, backs it up for what no
 // solver sees).
 #include <cstdlib>
 #include <filesystem>

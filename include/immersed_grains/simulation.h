@@ -7,6 +7,7 @@
 #include <deal.II/distributed/tria.h>
 
 #include <immersed_grains/coupling/coupling.h>
+#include <immersed_grains/divergence_guard.h>
 #include <immersed_grains/fluid/fluid_parameters.h>
 #include <immersed_grains/grains/cloud_analysis.h>
 #include <immersed_grains/grains/grain_parameters.h>
@@ -30,19 +31,35 @@
 namespace ImmersedGrains
 {
   template <int dim>
+  class CoupledStep;
+  template <int dim>
   class FluidSolver;
   template <int dim>
   class FieldOutput;
   template <int dim>
   class Grains;
+  template <int dim>
+  struct GrainStatistics;
   struct GrainStepReport;
+  class ProgressLine;
   template <int dim>
   class ParticleOutput;
 
   /**
-   * One run of a scene: owns the mesh, the fluid solver, the grains and the
-   * output, and strings them together in run(). It holds no physics of its
-   * own.
+   * One run of a scene: owns the mesh, the fluid solver, the grains, the
+   * coupling and the output, and strings them together in run(), which
+   * reads as the algorithm. It holds no physics of its own. Its members
+   * are defined over several files:
+   *  - source/simulation/core.cc: parameters, set-up, run() and the time
+   *    step;
+   *  - source/simulation/mesh.cc: adapting and repartitioning the mesh;
+   *  - source/simulation/checkpoint.cc: writing and resuming checkpoints;
+   *  - source/simulation/statistics.cc: the statistics row of each step,
+   *    timings, the progress line;
+   *  - source/scene_regime.cc: regime(), print_check() and the choice of
+   *    the drag distribution.
+   * The coupled step itself is CoupledStep (source/coupling/coupled_step.cc)
+   * and the divergence checks DivergenceGuard (source/divergence_guard.cc).
    */
   template <int dim>
   class Simulation
@@ -73,10 +90,12 @@ namespace ImmersedGrains
     print_check(std::ostream &out) const;
 
   private:
-    // Resolves Coupling/Drag distribution = auto from the placed grains
-    // (source/scene_regime.cc) and says why in drag_distribution_choice.
-    void
-    choose_drag_distribution(const std::string &file);
+    // --- core.cc ---------------------------------------------------------
+
+    // The newest complete checkpoint to resume from (Checkpoint/Resume),
+    // its physics checked against this scene's; empty to start afresh.
+    std::string
+    resume_point();
     // With @p resumed_step >= 0 the files of the run being resumed are
     // kept up to that step and appended to.
     void
@@ -85,6 +104,77 @@ namespace ImmersedGrains
     // a saved state.
     void
     setup(const std::string &resume_from);
+    // The output directory, the set-up, the initial row and output, the
+    // clocks and the divergence checks' scales.
+    void
+    start(const std::string &resume_from);
+    bool
+    finished() const;
+    double
+    next_time_step() const;
+    /** solve_time_step(), taken again with half the step where the fluid
+     *  step fails, up to Step retries times with Adaptive time step. */
+    void
+    solve_time_step_or_retry(double dt);
+    void
+    solve_time_step(double dt);
+    void
+    record_contacts(const GrainStepReport &report);
+    /** Stops the run (collective), after a last output, where a value is
+     *  not finite or a speed outruns what the scene drives
+     *  (DivergenceGuard). */
+    void
+    stop_if_diverging();
+    // Stops the run after a last output of the step: "step N (t = T s): "
+    // and @p what.
+    [[noreturn]] void
+    stop_run(const std::string &what);
+    // A failure inside run(): rethrown with the step named and, on one
+    // rank, a last output of what the step reached.
+    [[noreturn]] void
+    rethrow_failure(const std::exception &e, bool in_step);
+    void
+    maybe_write_fields(bool force);
+    // The run's last lines: what stopped short, the wall time, timers.
+    void
+    print_summary();
+    /** The grains' gravity less their buoyancy, |g| |1 - rho/rho_p| (rho
+     *  the fluid's density, 0 without fluid): their acceleration from
+     *  rest before drag acts. */
+    double
+    buoyant_gravity() const;
+
+    // --- mesh.cc ---------------------------------------------------------
+
+    // Refines and coarsens the mesh by the Adaptivity criteria and moves
+    // every state onto it; false if nothing changed.
+    bool
+    adapt_mesh();
+    // Moves every state across @p change of the mesh (refinement or
+    // repartitioning).
+    void
+    change_mesh(const std::function<void()> &change);
+    // Adapts the mesh when due, else repartitions it when the ranks' loads
+    // are uneven.
+    void
+    maybe_adapt_mesh();
+    // After a step: how far the fastest grain may have gone since the band
+    // was made.
+    void
+    track_grain_travel();
+    /** Whether adaptations follow the grains' travel (Adaptivity/Every
+     *  steps = auto with the grain band). */
+    bool
+    tracks_grain_travel() const;
+    /** Whether the grains follow their straight paths for a lookahead band
+     *  (Adaptivity/Band lookahead). */
+    bool
+    follows_straight_paths() const;
+    void
+    update_shortest_cell_edge();
+
+    // --- checkpoint.cc ---------------------------------------------------
+
     void
     maybe_write_checkpoint();
     void
@@ -107,82 +197,29 @@ namespace ImmersedGrains
     physics_reachable(const std::string &saved) const;
     void
     check_saved_physics(const std::string &directory) const;
-    // Refines and coarsens the mesh by the Adaptivity criteria and moves
-    // every state onto it; false if nothing changed.
-    bool
-    adapt_mesh();
-    // Moves every state across @p change of the mesh (refinement or
-    // repartitioning).
+
+    // --- statistics.cc ---------------------------------------------------
+
+    // The columns of statistics.csv: the interface's core columns first,
+    // in their documented order, then each owner's in turn.
+    static std::vector<std::string>
+    statistics_columns();
+    // The columns of timings.csv: the phases, each a sum of TimerOutput
+    // sections.
+    static std::vector<std::string>
+    timing_columns();
+    // The step's row: what the state measures (grains, fluid, coupling,
+    // clouds) beside what the step's solvers reported, written out.
     void
-    change_mesh(const std::function<void()> &change);
-    // Adapts the mesh when due, else repartitions it when the ranks' loads
-    // are uneven.
+    postprocess(double dt);
+    // dofs, fluid and solid volumes, pressure drop.
     void
-    maybe_adapt_mesh();
-    /** Whether adaptations follow the grains' travel (Adaptivity/Every
-     *  steps = auto with the grain band). */
-    bool
-    tracks_grain_travel() const;
-    /** Whether the grains follow their straight paths for a lookahead band
-     *  (Adaptivity/Band lookahead). */
-    bool
-    follows_straight_paths() const;
-    void
-    update_shortest_cell_edge();
-    double
-    next_time_step() const;
-    void
-    solve_time_step(double dt);
-    GrainStepReport
-    solve_coupled_time_step(double dt, unsigned int &fluid_iterations);
-    void
-    record_grain_step(const GrainStepReport &report);
-    void
-    postprocess(double dt, unsigned int fluid_iterations);
+    set_fluid_statistics();
     void
     set_grain_statistics();
     /** The cloud columns (Cloud analysis), and the break-up time once. */
     void
     set_cloud_statistics();
-    void
-    maybe_write_fields(bool force);
-    /** Stops the run (collective) where the fluid's solution or a grain's
-     *  velocity or position is NaN or Inf: the step, the field and where,
-     *  after a last output. */
-    void
-    stop_if_not_finite();
-    /** solve_time_step(), taken again with half the step where the fluid
-     *  step fails, up to Step retries times with Adaptive time step. */
-    void
-    solve_time_step_or_retry(double dt);
-    /** Stops the run (collective), as stop_if_not_finite(), where a fluid
-     *  or grain speed exceeds Divergence speed factor times the fastest
-     *  motion the scene drives (driven_speed()): an exploding run that
-     *  has not reached NaN yet, whose steps may have shrunk to nothing. */
-    void
-    stop_if_speeding();
-    /** The fastest motion the scene's data drive (collective): free fall
-     *  across the box along gravity, the grains' initial speeds and what
-     *  FluidSolver::driven_speed() counts for the fluid. */
-    double
-    driven_speed() const;
-
-    /** The grains' gravity less their buoyancy, |g| |1 - rho/rho_p| (rho
-     *  the fluid's density, 0 without fluid): their acceleration from
-     *  rest before drag acts. */
-    double
-    buoyant_gravity() const;
-    // Calls @p visit(cell centre, whether a velocity, value) for the fluid
-    // DoFs of each owned cell, in turn, until it returns true (the
-    // searches behind the messages above; failure paths only).
-    void
-    visit_fluid_values(
-      const std::function<bool(const dealii::Point<dim> &, bool, double)>
-        &visit) const;
-    // Stops the run after a last output of the step: "step N (t = T s): "
-    // and @p what.
-    [[noreturn]] void
-    stop_run(const std::string &what);
     /** The progress line, at most every Progress every seconds (a quarter
      *  of a second on a terminal); @p last: the run's last one. */
     void
@@ -193,20 +230,30 @@ namespace ImmersedGrains
     void
     record_timings();
 
+    // --- scene_regime.cc -------------------------------------------------
+
+    // Resolves Coupling/Drag distribution = auto from the placed grains
+    // and says why in drag_distribution_choice.
+    void
+    choose_drag_distribution(const std::string &file);
+
     MPI_Comm     comm;
     std::string  parameter_file;
     std::string  output_directory;
-    double       end_time                = 1;
-    double       time_step               = 1;
-    bool         adaptive_time_step      = false;
-    double       courant_number          = 0.1;
-    double       shortest_cell_edge      = 0;
-    double       divergence_speed_factor = 100;
-    double       initial_grain_speed     = 0;
-    unsigned int step_retries            = 3;
+    double       end_time           = 1;
+    double       time_step          = 1;
+    bool         adaptive_time_step = false;
+    double       courant_number     = 0.1;
+    double       shortest_cell_edge = 0;
+    unsigned int step_retries       = 3;
     // The length of the last step taken (0 before the first, and on
     // resuming): an adaptive step grows by at most twice it.
     double last_step = 0;
+    // The last step's length as its statistics row has it (restored on
+    // resuming): the fluid repays what it owes the grains at that rate.
+    double previous_step = 0;
+    // Fluid steps taken again shorter after a failure, since the start.
+    unsigned int retries_taken = 0;
     // How far the fastest grain may have travelled since the last
     // adaptation (a sum of the largest speed over each step times the
     // step), and that speed at the start of the step being taken.
@@ -215,9 +262,8 @@ namespace ImmersedGrains
     // Band lookahead: when the band was last made.
     double band_made_at       = 0;
     bool   warned_band_outrun = false;
-    // The largest speed over the driven speed so far, and that speed then.
-    double largest_speed_ratio = 0;
-    double driven_at_largest   = 0;
+    // When the cloud broke up (-1: not yet).
+    double breakup_time = -1;
 
     unsigned int                    write_fields_every = 0;
     OutputFormat                    output_format      = OutputFormat::vtu;
@@ -225,20 +271,13 @@ namespace ImmersedGrains
     bool                            quiet              = false;
     bool                            verbose            = false;
     double                          progress_interval  = 10;
-    double                          last_progress_wall = 0;
     double                          start_time         = 0;
     std::vector<std::string>        test_columns;
     unsigned int                    test_every = 1;
     std::vector<TestCheck>          test_checks;
     std::vector<dealii::Point<dim>> pressure_drop_points;
     std::string                     pressure_drop_text;
-    unsigned int                    clamped_nodes_before  = 0;
     unsigned int                    preconditioner_builds = 0;
-    // The drag impulses the phases exchanged since the run (or resume)
-    // began: their sum, which the fluid still owes where the books
-    // balance, and the grains' total (momentum_exchange_drift).
-    dealii::Tensor<1, dim> exchange_imbalance;
-    double                 exchanged_impulse = 0;
     // Steps whose contact solve stopped at Contacts/Max iterations.
     unsigned int capped_contact_steps = 0;
 
@@ -250,6 +289,7 @@ namespace ImmersedGrains
     typename LoadBalance<dim>::Parameters   load_balance_parameters;
     Checkpoint::Parameters                  checkpoint_parameters;
     typename CloudAnalysis<dim>::Parameters cloud_parameters;
+    DivergenceGuard<dim>                    divergence_guard;
     double                                  largest_grain_radius = 0;
     double                                  mean_grain_radius    = 0;
     unsigned int                            placed_grains        = 0;
@@ -264,6 +304,7 @@ namespace ImmersedGrains
     dealii::ConditionalOStream           pcout;
     dealii::ConditionalOStream           pdetail;
     std::unique_ptr<dealii::TimerOutput> timer;
+    std::unique_ptr<ProgressLine>        progress;
     Statistics                           statistics;
     Statistics                           timings;
 
@@ -273,10 +314,15 @@ namespace ImmersedGrains
     std::unique_ptr<Grains<dim>>                      grains;
     std::unique_ptr<ParticleOutput<dim>>              particle_output;
     std::unique_ptr<Coupling<dim>>                    coupling;
-    std::unique_ptr<Adaptivity<dim>>                  adaptivity;
-    std::unique_ptr<LoadBalance<dim>>                 load_balance;
-    std::unique_ptr<Checkpoint>                       checkpoint;
-    std::unique_ptr<CloudAnalysis<dim>>               cloud_analysis;
+    // Kept across the re-set-up after a checkpoint: its books go on.
+    std::unique_ptr<CoupledStep<dim>>   coupled_step;
+    std::unique_ptr<Adaptivity<dim>>    adaptivity;
+    std::unique_ptr<LoadBalance<dim>>   load_balance;
+    std::unique_ptr<Checkpoint>         checkpoint;
+    std::unique_ptr<CloudAnalysis<dim>> cloud_analysis;
+    // The grains' measures of the last row (its max_speed sets the
+    // adaptation's reach; the divergence checks read them).
+    std::unique_ptr<GrainStatistics<dim>> grain_statistics;
 
     double       time = 0;
     unsigned int step = 0;

@@ -430,6 +430,44 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  typename Coupling<dim>::GrainDrag
+  Coupling<dim>::grain_drag(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const dealii::Point<dim>                                        &reference,
+    const GrainStepArrays<dim>                                      &arrays,
+    const unsigned int                                               i,
+    const double                  felt_fraction,
+    const dealii::Tensor<1, dim> &felt,
+    const double                  dt,
+    const bool                    frozen) const
+  {
+    const auto  &c = arrays.contact;
+    const double r = c.radius[i];
+    GrainDrag    drag;
+    DragInput    in        = drag_input(r, felt_fraction, c.velocity[i] - felt);
+    drag.gamma             = drag_law->coefficient(in);
+    drag.held              = held(arrays, i, arrays.mass[i] + dt * drag.gamma);
+    const auto [phi, self] = undisturbed(cell,
+                                         reference,
+                                         r,
+                                         felt_fraction,
+                                         c.velocity[i] - felt,
+                                         arrays,
+                                         i,
+                                         frozen ? 0.0 : dt,
+                                         !arrays.fixed[i] && !drag.held);
+    if (phi != felt_fraction || self.norm() > 0)
+    {
+      in         = drag_input(r, phi, c.velocity[i] - (felt - self));
+      drag.gamma = drag_law->coefficient(in);
+    }
+    drag.self     = self;
+    drag.reynolds = DragLaw::reynolds(in);
+    return drag;
+  }
+
+
+  template <int dim>
   bool
   Coupling<dim>::held(const GrainStepArrays<dim> &arrays,
                       const unsigned int          i,
@@ -526,10 +564,16 @@ namespace ImmersedGrains
           if (!implicit_velocity)
             lagged_force[i] -= (scale.empty() ? 1.0 : scale[k]) * V *
                                fluid_values[k].pressure_gradient;
-          DragInput in =
-            drag_input(r, felt_fraction[k], c.velocity[i] - felt[k]);
-          gamma[i]        = drag_law->coefficient(in);
-          const bool held = this->held(arrays, i, m + dt * gamma[i]);
+          const GrainDrag drag_of_grain = grain_drag(cell,
+                                                     references[k],
+                                                     arrays,
+                                                     i,
+                                                     felt_fraction[k],
+                                                     felt[k],
+                                                     dt,
+                                                     false);
+          gamma[i]                      = drag_of_grain.gamma;
+          const bool held               = drag_of_grain.held;
           if (!predicted_impulse.empty())
           {
             // Grains that collide and part in turn get impulses that flip
@@ -543,22 +587,9 @@ namespace ImmersedGrains
             predicted_impulse[i] = w * arrays.contact_impulse[i] +
                                    (1 - w) * arrays.predicted_impulse[i];
           }
-          const auto [phi, self] = undisturbed(cell,
-                                               references[k],
-                                               r,
-                                               felt_fraction[k],
-                                               c.velocity[i] - felt[k],
-                                               arrays,
-                                               i,
-                                               dt,
-                                               !arrays.fixed[i] && !held);
-          if (phi != felt_fraction[k] || self.norm() > 0)
-          {
-            in       = drag_input(r, phi, c.velocity[i] - (felt[k] - self));
-            gamma[i] = drag_law->coefficient(in);
-          }
-          self_velocity[i] = self;
-          reynolds_max     = std::max(reynolds_max, DragLaw::reynolds(in));
+          const dealii::Tensor<1, dim> self = drag_of_grain.self;
+          self_velocity[i]                  = self;
+          reynolds_max = std::max(reynolds_max, drag_of_grain.reynolds);
 
           // The drag the fluid sees after eliminating the grain's implicit
           // update (a fixed grain is infinitely heavy: full gamma, v = 0).
@@ -775,23 +806,10 @@ namespace ImmersedGrains
           const double V = grain_volume<dim>(c.radius[i]);
           if (!as_predicted)
           {
-            const double m = arrays.mass[i];
-            gamma[i]       = drag_law->coefficient(
-              drag_input(c.radius[i], felt_fraction[k], c.velocity[i] - u));
-            const auto [phi, self] =
-              undisturbed(cell,
-                          references[k],
-                          c.radius[i],
-                          felt_fraction[k],
-                          c.velocity[i] - u,
-                          arrays,
-                          i,
-                          0,
-                          !arrays.fixed[i] &&
-                            !held(arrays, i, m + dt * gamma[i]));
-            if (phi != felt_fraction[k] || self.norm() > 0)
-              gamma[i] = drag_law->coefficient(
-                drag_input(c.radius[i], phi, c.velocity[i] - (u - self)));
+            const GrainDrag drag_of_grain = grain_drag(
+              cell, references[k], arrays, i, felt_fraction[k], u, dt, true);
+            gamma[i]                          = drag_of_grain.gamma;
+            const dealii::Tensor<1, dim> self = drag_of_grain.self;
             arrays.drag_velocity[i] -= self;
             if (!arrays.self_velocity.empty())
               arrays.self_velocity[i] = self;

@@ -36,7 +36,7 @@ namespace ImmersedGrains
   namespace
   {
     // The most unknowns for which one rank factorises the filter's matrix
-    // (doc/performance.md, fourteenth round). In 2D the factors of this
+    // (doc/performance.md). In 2D the factors of this
     // Laplacian-like matrix grow like n log n, and their triangular solves
     // beat the 25-30 Jacobi-CG iterations: the solid fraction's and the
     // interaction force's phases took a third less time on the 2D cloud's

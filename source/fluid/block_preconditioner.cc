@@ -45,8 +45,8 @@ namespace ImmersedGrains
       // thresholds 0 or 0.1 were all as good or worse. One sweep before
       // and after rather than two: 0-5 % more outer iterations on the
       // preconditioner benchmarks, but each V-cycle costs about half, and
-      // the solves took 16-45 % less time (doc/performance.md, eighth
-      // round).
+      // the solves took 16-45 % less time (doc/performance.md, the
+      // velocity AMG's smoother).
       data.smoother_type         = "ILU";
       data.smoother_sweeps       = 1;
       data.aggregation_threshold = settings.velocity_aggregation_threshold;

@@ -104,7 +104,7 @@ namespace ImmersedGrains
     // all round, as on the benchmark; periodic and slip faces do not
     // confine: a column 1 x 8 with them sideways, 42 -> 33 and 36 -> 31
     // iterations at most, doc/adaptivity.md). Measured on the
-    // drag-jump benchmark (doc/benchmarks.md, fifth and sixth rounds):
+    // drag-jump benchmark (doc/benchmarks.md):
     // with exact inner solves the best floor on fine meshes is a Darcy
     // coefficient of the order of mu/L^2, i.e. a fraction of mu/h^2 that
     // falls like (h/L)^2 (a fixed fraction over-counts the Darcy term of
@@ -133,7 +133,7 @@ namespace ImmersedGrains
     // also weighs down. Lightening the drag cells leaves M_w^{-1} there to the
     // clear fluid's side: drag-jump benchmark, steady, beta h^2/mu = 1e4 / 1e8,
     // 3D level 4: 30 / 33 -> 22 / 22 iterations, 2D level 7: 33 / 33 -> 24 /
-    // 23; dt = 1, 2D level 7: 22 -> 15 (doc/benchmarks.md, seventh round). The
+    // 23; dt = 1, 2D level 7: 22 -> 15 (doc/benchmarks.md). The
     // factor falls smoothly from 1 below r = 100 to 0.03, where it stops so
     // that M_w keeps a bounded contrast for its ILU (0.01 and 0.1 as the
     // bound: 23 / 21 and 21 / 24 at 3D level 4).
@@ -164,6 +164,313 @@ namespace ImmersedGrains
                              viscosity;
       return *beta_max * h * h + viscous >
              contrast * (*beta_min * h * h + viscous);
+    }
+    // The reference cell's scalar shape functions at the quadrature points.
+    // Every cell is an axis-parallel box (the mapping is MappingCartesian),
+    // so the values on a cell are these and its gradients these over the
+    // cell's extents (scale_to_cell()): computed once per assembly instead
+    // of FEValues::reinit copying all of them for every cell (3 % of the
+    // 3D cloud's run).
+    template <int dim>
+    std::vector<ScalarShapes<dim>>
+    reference_shapes(const dealii::FESystem<dim>   &fe,
+                     const ScalarDofs<dim>         &dofs,
+                     const dealii::Quadrature<dim> &quadrature)
+    {
+      const unsigned int n_s = dofs.velocity.size(), n_p = dofs.pressure.size();
+      std::vector<ScalarShapes<dim>> shapes(quadrature.size());
+      for (unsigned int q = 0; q < quadrature.size(); ++q)
+      {
+        const auto &x = quadrature.point(q);
+        shapes[q].resize(n_s, n_p);
+        for (unsigned int a = 0; a < n_s; ++a)
+        {
+          shapes[q].N[a]  = fe.shape_value(dofs.velocity[a][0], x);
+          const auto grad = fe.shape_grad(dofs.velocity[a][0], x);
+          for (unsigned int d = 0; d < dim; ++d)
+            shapes[q].G[d][a] = grad[d];
+        }
+        for (unsigned int b = 0; b < n_p; ++b)
+        {
+          shapes[q].Np[b] = fe.shape_value(dofs.pressure[b], x);
+          const auto grad = fe.shape_grad(dofs.pressure[b], x);
+          for (unsigned int d = 0; d < dim; ++d)
+            shapes[q].Gp[d][b] = grad[d];
+        }
+      }
+      return shapes;
+    }
+
+    // The gradients, weights and points of the box @p cell.
+    template <int dim, typename CellIterator>
+    void
+    scale_to_cell(const CellIterator                   &cell,
+                  const dealii::Quadrature<dim>        &quadrature,
+                  const std::vector<ScalarShapes<dim>> &reference,
+                  std::vector<ScalarShapes<dim>>       &shapes,
+                  std::vector<double>                  &JxW,
+                  std::vector<dealii::Point<dim>>      &points)
+    {
+      const dealii::Point<dim>     lower = cell->vertex(0);
+      const dealii::Tensor<1, dim> extent =
+        cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1) - lower;
+      double measure = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        measure *= extent[d];
+      const unsigned int n_s = reference[0].N.size();
+      const unsigned int n_p = reference[0].Np.size();
+      for (unsigned int q = 0; q < quadrature.size(); ++q)
+      {
+        JxW[q] = quadrature.weight(q) * measure;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          points[q][d]         = lower[d] + extent[d] * quadrature.point(q)[d];
+          const double inverse = 1.0 / extent[d];
+          for (unsigned int a = 0; a < n_s; ++a)
+            shapes[q].G[d][a] = reference[q].G[d][a] * inverse;
+          for (unsigned int b = 0; b < n_p; ++b)
+            shapes[q].Gp[d][b] = reference[q].Gp[d][b] * inverse;
+        }
+      }
+    }
+
+    // The cell's coefficients of the current iterate and of its history.
+    struct LocalSolutions
+    {
+      std::vector<double> current, old, older;
+      bool                with_history      = false;
+      bool                drag_against_last = false;
+    };
+
+    // The current iterate, its history and the mixture at point @p q.
+    template <int dim>
+    void
+    evaluate_point_state(const ScalarShapes<dim>      &shapes,
+                         const ScalarDofs<dim>        &dofs,
+                         const LocalSolutions         &local,
+                         const std::array<double, 3>  &bdf,
+                         const MixtureValues<dim>     &mixture,
+                         const unsigned int            q,
+                         const dealii::Vector<double> *forcing,
+                         PointState<dim>              &state)
+    {
+      const auto &N   = shapes.N;
+      const auto &G   = shapes.G;
+      state.u         = dealii::Tensor<1, dim>();
+      state.u_history = dealii::Tensor<1, dim>();
+      state.u_last    = dealii::Tensor<1, dim>();
+      state.grad_u    = dealii::Tensor<2, dim>();
+      state.p         = 0;
+      state.grad_p    = dealii::Tensor<1, dim>();
+      for (unsigned int a = 0; a < N.size(); ++a)
+        for (unsigned int c = 0; c < dim; ++c)
+        {
+          const unsigned int k = dofs.velocity[a][c];
+          state.u[c] += local.current[k] * N[a];
+          for (unsigned int d = 0; d < dim; ++d)
+            state.grad_u[c][d] += local.current[k] * G[d][a];
+          if (local.with_history)
+            state.u_history[c] +=
+              (bdf[1] * local.old[k] + bdf[2] * local.older[k]) * N[a];
+          if (local.drag_against_last)
+            state.u_last[c] += local.old[k] * N[a];
+        }
+      for (unsigned int b = 0; b < shapes.Np.size(); ++b)
+      {
+        const double value = local.current[dofs.pressure[b]];
+        state.p += value * shapes.Np[b];
+        for (unsigned int d = 0; d < dim; ++d)
+          state.grad_p[d] += value * shapes.Gp[d][b];
+      }
+      state.phi            = mixture.fluid_fraction[q];
+      state.grad_phi       = mixture.fluid_fraction_gradient[q];
+      state.beta           = mixture.drag_coefficient[q];
+      state.grain_velocity = mixture.grain_velocity[q];
+      state.beta_last      = mixture.last_velocity_drag[q];
+      state.solid_flux     = mixture.solid_flux[q];
+      state.mass_source    = mixture.mass_source[q];
+      state.alpha          = mixture.pressure_gradient_weight[q];
+      state.mobility       = mixture.pressure_mobility[q];
+      if (forcing)
+        for (unsigned int d = 0; d < dim; ++d)
+          state.forcing[d] = (*forcing)(d);
+    }
+
+    // The momentum terms' coefficients @p m at one point, integrated: the
+    // velocity rows of the residual (force and stress against N_a and
+    // grad N_a, the pressure against div(phi N_a e_c) = phi dN_a/dx_c +
+    // dphi/dx_c N_a) and the scalar velocity block
+    //   K_ab += reaction N_a N_b + diffusion grad N_a . grad N_b
+    //         + convection_weight (convection . grad N_b) N_a,
+    // with Newton's convection_weight (grad u)_cd N_b N_a in W.
+    template <int dim>
+    void
+    integrate_momentum(const MomentumCoefficients<dim> &m,
+                       const PointState<dim>           &state,
+                       const ScalarShapes<dim>         &shapes,
+                       const double                     JxW,
+                       const bool                       convection,
+                       const bool                       convection_derivative,
+                       std::vector<double>             &advection_weight,
+                       CellIntegrals                   &integrals)
+    {
+      const auto        &N   = shapes.N;
+      const auto        &G   = shapes.G;
+      const unsigned int n_s = N.size();
+      for (unsigned int a = 0; a < n_s; ++a)
+        for (unsigned int c = 0; c < dim; ++c)
+        {
+          double stress_a = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            stress_a += m.stress[c][d] * G[d][a];
+          integrals.rhs_u[a * dim + c] -=
+            (m.force[c] * N[a] + stress_a -
+             m.pressure * (state.phi * G[c][a] + state.grad_phi[c] * N[a])) *
+            JxW;
+        }
+
+      const double w_mass    = m.reaction * JxW;
+      const double w_viscous = m.diffusion * JxW;
+      for (unsigned int b = 0; b < n_s; ++b)
+      {
+        advection_weight[b] = w_mass * N[b];
+        if (convection)
+        {
+          double adv = 0;
+          for (unsigned int d = 0; d < dim; ++d)
+            adv += m.convection[d] * G[d][b];
+          advection_weight[b] += m.convection_weight * adv * JxW;
+        }
+      }
+      add_to_velocity_block(n_s,
+                            dim,
+                            N.data(),
+                            G[0].data(),
+                            G[1].data(),
+                            dim == 3 ? G[dim - 1].data() : nullptr,
+                            advection_weight.data(),
+                            w_viscous,
+                            integrals.K.data());
+      if (convection_derivative)
+        // convection_weight (grad u)_cd N_b N_a couples component c of
+        // the row with component d of the column.
+        for (unsigned int c = 0; c < dim; ++c)
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double w =
+              m.convection_weight * m.convection_derivative[c][d] * JxW;
+            double *block = &integrals.W[(c * dim + d) * n_s * n_s];
+            for (unsigned int a = 0; a < n_s; ++a)
+              for (unsigned int b = 0; b < n_s; ++b)
+                block[a * n_s + b] += w * N[a] * N[b];
+          }
+    }
+
+    // What the preconditioner's pieces gather over a cell and the mesh.
+    struct SchurSums
+    {
+      // Integrals of the drag coefficient field and of the viscosity phi mu
+      // over the cell, for drag_cell_mass_factor. Not the grains' point or
+      // cell drag: rank one per grain or cell, it leaves the cell's other
+      // velocity modes viscous, and counting it cost a packed bed 2 more
+      // iterations per step (tests/coupled_resting_column: 40-44 instead
+      // of 38-42).
+      double cell_drag      = 0;
+      double cell_viscosity = 0;
+      // The largest ratio of the viscous and advective parts of A to its
+      // mass-and-drag part, at the spacing of the velocity nodes: where it
+      // is small, A is nearly diagonal (the entry Velocity
+      // preconditioner).
+      double max_viscous_number = 0;
+    };
+
+    // The Schur complement approximation (block_preconditioner.h) at one
+    // point: the pressure mass matrix weighted by phi/mu and the diagonal
+    // of the mass-and-drag part c M of A, c = phi rho a0/dt + beta, plus
+    // its floor (@p floor_factor, schur_floor_factor()).
+    template <int dim>
+    void
+    integrate_schur_pieces(const MomentumCoefficients<dim> &m,
+                           const PointState<dim>           &state,
+                           const ScalarShapes<dim>         &shapes,
+                           const double                     JxW,
+                           const double                     viscosity,
+                           const double                     spacing,
+                           const double                     floor_factor,
+                           const bool                       convection,
+                           CellIntegrals                   &integrals,
+                           SchurSums                       &sums,
+                           double                          &max_beta)
+    {
+      const auto  &N           = shapes.N;
+      const auto  &G           = shapes.G;
+      const double w_mass      = m.reaction * JxW;
+      const double w_viscous   = m.diffusion * JxW;
+      const double mass_weight = state.phi / viscosity * JxW;
+      const double c           = m.reaction;
+      double viscous_number    = c > 0 ? m.diffusion / (c * spacing * spacing) :
+                                         std::numeric_limits<double>::infinity();
+      if (convection && c > 0)
+        viscous_number =
+          std::max(viscous_number,
+                   m.convection_weight * state.u.norm() / (c * spacing));
+      sums.max_viscous_number =
+        std::max(sums.max_viscous_number, viscous_number);
+      sums.cell_drag += state.beta * JxW;
+      sums.cell_viscosity += m.diffusion * JxW;
+      max_beta               = std::max(max_beta, state.beta);
+      const unsigned int n_p = shapes.Np.size();
+      for (unsigned int b = 0; b < n_p; ++b)
+        for (unsigned int e = 0; e < n_p; ++e)
+          integrals.Mp[b * n_p + e] +=
+            mass_weight * shapes.Np[b] * shapes.Np[e];
+      for (unsigned int a = 0; a < N.size(); ++a)
+      {
+        double g = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          g += G[d][a] * G[d][a];
+        integrals.R[a] += w_mass * N[a] * N[a] + floor_factor * w_viscous * g;
+      }
+    }
+
+    // The scalar integrals onto the vector-valued cell matrix and
+    // right-hand side.
+    template <int dim>
+    void
+    fill_cell_system(const CellIntegrals        &integrals,
+                     const ScalarDofs<dim>      &dofs,
+                     const bool                  convection_derivative,
+                     dealii::FullMatrix<double> &cell_matrix,
+                     dealii::Vector<double>     &cell_rhs)
+    {
+      const unsigned int n_s = integrals.n_s, n_p = integrals.n_p;
+      cell_matrix = 0;
+      for (unsigned int c = 0; c < dim; ++c)
+        for (unsigned int a = 0; a < n_s; ++a)
+        {
+          const unsigned int i = dofs.velocity[a][c];
+          cell_rhs(i)          = integrals.rhs_u[a * dim + c];
+          for (unsigned int b = 0; b < n_s; ++b)
+            cell_matrix(i, dofs.velocity[b][c]) = integrals.K[a * n_s + b];
+          if (convection_derivative)
+            for (unsigned int d = 0; d < dim; ++d)
+              for (unsigned int b = 0; b < n_s; ++b)
+                cell_matrix(i, dofs.velocity[b][d]) +=
+                  integrals.W[(c * dim + d) * n_s * n_s + a * n_s + b];
+          for (unsigned int b = 0; b < n_p; ++b)
+          {
+            const double value = integrals.B[(c * n_s + a) * n_p + b];
+            cell_matrix(i, dofs.pressure[b]) = value;
+            cell_matrix(dofs.pressure[b], i) = value;
+          }
+        }
+      for (unsigned int b = 0; b < n_p; ++b)
+      {
+        cell_rhs(dofs.pressure[b]) = integrals.rhs_p[b];
+        for (unsigned int e = 0; e < n_p; ++e)
+          cell_matrix(dofs.pressure[b], dofs.pressure[e]) =
+            integrals.C[b * n_p + e];
+      }
     }
   } // namespace
 
@@ -212,14 +519,9 @@ namespace ImmersedGrains
     const dealii::QGauss<dim> quadrature(fe.degree + 1);
     const unsigned int        dofs_per_cell = fe.n_dofs_per_cell();
     const unsigned int        n_q           = quadrature.size();
-
-    // Local index of velocity component c of scalar Q2 function a, and of
-    // pressure function b.
-    const unsigned int    n_s = fe.base_element(0).n_dofs_per_cell();
-    const unsigned int    n_p = fe.base_element(1).n_dofs_per_cell();
-    const ScalarDofs<dim> dofs(fe);
-    const auto           &velocity_dof = dofs.velocity;
-    const auto           &pressure_dof = dofs.pressure;
+    const unsigned int        n_s = fe.base_element(0).n_dofs_per_cell();
+    const unsigned int        n_p = fe.base_element(1).n_dofs_per_cell();
+    const ScalarDofs<dim>     dofs(fe);
 
     const double rho = parameters.density, mu = parameters.viscosity;
     const double inv_dt =
@@ -243,36 +545,15 @@ namespace ImmersedGrains
     dealii::Vector<double>                       cell_reaction(dofs_per_cell);
     const double                                 wall_gap = geometry.wall_gap();
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
-    std::vector<double>                          local_solution(dofs_per_cell);
-    std::vector<double> local_old(dofs_per_cell), local_older(dofs_per_cell);
+    LocalSolutions                               local;
+    local.current.resize(dofs_per_cell);
+    local.old.resize(dofs_per_cell);
+    local.older.resize(dofs_per_cell);
+    local.with_history = inv_dt > 0;
 
-    // Every cell is an axis-parallel box (the mapping is MappingCartesian),
-    // so the shape functions' values at the quadrature points are the
-    // reference cell's and their gradients the reference gradients over
-    // the cell's extents: computed once here and scaled per cell, instead
-    // of FEValues::reinit copying all of them for every cell (3 % of the
-    // 3D cloud's run).
-    std::vector<ScalarShapes<dim>> reference_shapes(n_q);
-    for (unsigned int q = 0; q < n_q; ++q)
-    {
-      const auto &x = quadrature.point(q);
-      reference_shapes[q].resize(n_s, n_p);
-      for (unsigned int a = 0; a < n_s; ++a)
-      {
-        reference_shapes[q].N[a] = fe.shape_value(velocity_dof[a][0], x);
-        const auto grad          = fe.shape_grad(velocity_dof[a][0], x);
-        for (unsigned int d = 0; d < dim; ++d)
-          reference_shapes[q].G[d][a] = grad[d];
-      }
-      for (unsigned int b = 0; b < n_p; ++b)
-      {
-        reference_shapes[q].Np[b] = fe.shape_value(pressure_dof[b], x);
-        const auto grad           = fe.shape_grad(pressure_dof[b], x);
-        for (unsigned int d = 0; d < dim; ++d)
-          reference_shapes[q].Gp[d][b] = grad[d];
-      }
-    }
-    std::vector<ScalarShapes<dim>>  cell_shapes = reference_shapes;
+    const std::vector<ScalarShapes<dim>> reference =
+      reference_shapes(fe, dofs, quadrature);
+    std::vector<ScalarShapes<dim>>  cell_shapes = reference;
     std::vector<double>             JxW_values(n_q);
     std::vector<dealii::Point<dim>> points(n_q);
     CellIntegrals                   integrals;
@@ -281,77 +562,46 @@ namespace ImmersedGrains
     CellContext<dim>    context;
     context.shapes                = &cell_shapes;
     context.JxW                   = &JxW_values;
-    context.local_solution        = &local_solution;
+    context.local_solution        = &local.current;
     context.preconditioner_pieces = assemble_preconditioner_matrices;
 
     std::vector<dealii::Vector<double>> f(n_q, dealii::Vector<double>(dim));
     MixtureValues<dim>                  mixture;
     PointState<dim>                     state;
-    const bool                          with_history = inv_dt > 0;
 
     AssertThrow(cell_gather->matches(solution) &&
                   cell_gather->matches(old_solution) &&
                   cell_gather->matches(old_old_solution),
                 dealii::ExcInternalError());
 
-    unsigned int averaged_cells = 0;
-    // The largest ratio of the viscous and advective parts of A to its
-    // mass-and-drag part, at the spacing of the velocity nodes: where it
-    // is small, A is nearly diagonal (the entry Velocity preconditioner).
-    double max_viscous_number = 0;
-
-    unsigned int owned_cell = 0; // the cell's number for cell_scatter
+    unsigned int averaged_cells     = 0;
+    double       max_viscous_number = 0;
+    unsigned int owned_cell         = 0; // the cell's number for cell_scatter
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
       if (!cell->is_locally_owned())
         continue;
       const unsigned int cell_number = owned_cell++;
+      scale_to_cell(
+        cell, quadrature, reference, cell_shapes, JxW_values, points);
+      cell_gather->gather(cell_number, solution, local.current);
+      if (local.with_history)
       {
-        const dealii::Point<dim>     lower = cell->vertex(0);
-        const dealii::Tensor<1, dim> extent =
-          cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1) -
-          lower;
-        double measure = 1;
-        for (unsigned int d = 0; d < dim; ++d)
-          measure *= extent[d];
-        for (unsigned int q = 0; q < n_q; ++q)
-        {
-          JxW_values[q] = quadrature.weight(q) * measure;
-          for (unsigned int d = 0; d < dim; ++d)
-          {
-            points[q][d] = lower[d] + extent[d] * quadrature.point(q)[d];
-            const double inverse = 1.0 / extent[d];
-            for (unsigned int a = 0; a < n_s; ++a)
-              cell_shapes[q].G[d][a] = reference_shapes[q].G[d][a] * inverse;
-            for (unsigned int b = 0; b < n_p; ++b)
-              cell_shapes[q].Gp[d][b] = reference_shapes[q].Gp[d][b] * inverse;
-          }
-        }
-      }
-      cell_gather->gather(cell_number, solution, local_solution);
-      if (with_history)
-      {
-        cell_gather->gather(cell_number, old_solution, local_old);
-        cell_gather->gather(cell_number, old_old_solution, local_older);
+        cell_gather->gather(cell_number, old_solution, local.old);
+        cell_gather->gather(cell_number, old_old_solution, local.older);
       }
       integrals.clear(assemble_preconditioner_matrices);
-      // Integrals of the drag coefficient field and of the viscosity phi mu
-      // over the cell, for drag_cell_mass_factor. Not the grains' point or
-      // cell drag: rank one per grain or cell, it leaves the cell's other
-      // velocity modes viscous, and counting it cost a packed bed 2 more
-      // iterations per step (tests/coupled_resting_column: 40-44 instead of
-      // 38-42).
-      double cell_drag = 0, cell_viscosity = 0;
+      SchurSums schur;
 
       mixture_fields->evaluate(
         cell, points, quadrature.get_points(), time, mixture);
       // u^n, also where a drag field is taken against it.
-      const bool drag_against_last =
+      local.drag_against_last =
         std::any_of(mixture.last_velocity_drag.begin(),
                     mixture.last_velocity_drag.end(),
                     [](const double b) { return b != 0; });
-      if (drag_against_last && !with_history)
-        cell_gather->gather(cell_number, old_solution, local_old);
+      if (local.drag_against_last && !local.with_history)
+        cell_gather->gather(cell_number, old_solution, local.old);
       const double h            = std::pow(cell->measure(), 1.0 / dim);
       const double floor_factor = schur_floor_factor(h, wall_gap);
       using DragAveraging       = typename FluidParameters<dim>::DragAveraging;
@@ -378,141 +628,40 @@ namespace ImmersedGrains
       for (unsigned int q = 0; q < n_q; ++q)
       {
         const ScalarShapes<dim> &shapes = cell_shapes[q];
-        const auto              &N      = shapes.N;
-        const auto              &G      = shapes.G;
-
-        // The current iterate and the history at this point.
-        state.u         = dealii::Tensor<1, dim>();
-        state.u_history = dealii::Tensor<1, dim>();
-        state.u_last    = dealii::Tensor<1, dim>();
-        state.grad_u    = dealii::Tensor<2, dim>();
-        state.p         = 0;
-        state.grad_p    = dealii::Tensor<1, dim>();
-        for (unsigned int a = 0; a < n_s; ++a)
-          for (unsigned int c = 0; c < dim; ++c)
-          {
-            const unsigned int k = velocity_dof[a][c];
-            state.u[c] += local_solution[k] * N[a];
-            for (unsigned int d = 0; d < dim; ++d)
-              state.grad_u[c][d] += local_solution[k] * G[d][a];
-            if (with_history)
-              state.u_history[c] +=
-                (bdf[1] * local_old[k] + bdf[2] * local_older[k]) * N[a];
-            if (drag_against_last)
-              state.u_last[c] += local_old[k] * N[a];
-          }
-        for (unsigned int b = 0; b < n_p; ++b)
-        {
-          const double value = local_solution[pressure_dof[b]];
-          state.p += value * shapes.Np[b];
-          for (unsigned int d = 0; d < dim; ++d)
-            state.grad_p[d] += value * shapes.Gp[d][b];
-        }
-        state.phi            = mixture.fluid_fraction[q];
-        state.grad_phi       = mixture.fluid_fraction_gradient[q];
-        state.beta           = mixture.drag_coefficient[q];
-        state.grain_velocity = mixture.grain_velocity[q];
-        state.beta_last      = mixture.last_velocity_drag[q];
-        state.solid_flux     = mixture.solid_flux[q];
-        state.mass_source    = mixture.mass_source[q];
-        state.alpha          = mixture.pressure_gradient_weight[q];
-        state.mobility       = mixture.pressure_mobility[q];
-        if (terms.forcing)
-          for (unsigned int d = 0; d < dim; ++d)
-            state.forcing[d] = f[q](d);
-        const double JxW = JxW_values[q];
-
+        evaluate_point_state(shapes,
+                             dofs,
+                             local,
+                             bdf,
+                             mixture,
+                             q,
+                             terms.forcing ? &f[q] : nullptr,
+                             state);
         MomentumCoefficients<dim> m;
         for (const auto *term : terms.at_points)
-          term->point(state, shapes, JxW, m, integrals);
-
-        // Velocity rows: force and stress against N_a and grad N_a, the
-        // pressure against div(phi N_a e_c) = phi dN_a/dx_c + dphi/dx_c N_a.
-        for (unsigned int a = 0; a < n_s; ++a)
-          for (unsigned int c = 0; c < dim; ++c)
-          {
-            double stress_a = 0;
-            for (unsigned int d = 0; d < dim; ++d)
-              stress_a += m.stress[c][d] * G[d][a];
-            integrals.rhs_u[a * dim + c] -=
-              (m.force[c] * N[a] + stress_a -
-               m.pressure * (state.phi * G[c][a] + state.grad_phi[c] * N[a])) *
-              JxW;
-          }
-
-        // K_ab += reaction N_a N_b + diffusion grad N_a . grad N_b
-        //       + convection_weight (convection . grad N_b) N_a.
-        const double w_mass    = m.reaction * JxW;
-        const double w_viscous = m.diffusion * JxW;
-        for (unsigned int b = 0; b < n_s; ++b)
-        {
-          advection_weight[b] = w_mass * N[b];
-          if (convection)
-          {
-            double adv = 0;
-            for (unsigned int d = 0; d < dim; ++d)
-              adv += m.convection[d] * G[d][b];
-            advection_weight[b] += m.convection_weight * adv * JxW;
-          }
-        }
-        add_to_velocity_block(n_s,
-                              dim,
-                              N.data(),
-                              G[0].data(),
-                              G[1].data(),
-                              dim == 3 ? G[dim - 1].data() : nullptr,
-                              advection_weight.data(),
-                              w_viscous,
-                              integrals.K.data());
-        if (convection_derivative)
-          // convection_weight (grad u)_cd N_b N_a couples component c of
-          // the row with component d of the column.
-          for (unsigned int c = 0; c < dim; ++c)
-            for (unsigned int d = 0; d < dim; ++d)
-            {
-              const double w =
-                m.convection_weight * m.convection_derivative[c][d] * JxW;
-              double *block = &integrals.W[(c * dim + d) * n_s * n_s];
-              for (unsigned int a = 0; a < n_s; ++a)
-                for (unsigned int b = 0; b < n_s; ++b)
-                  block[a * n_s + b] += w * N[a] * N[b];
-            }
-
+          term->point(state, shapes, JxW_values[q], m, integrals);
+        integrate_momentum(m,
+                           state,
+                           shapes,
+                           JxW_values[q],
+                           convection,
+                           convection_derivative,
+                           advection_weight,
+                           integrals);
         if (assemble_preconditioner_matrices)
-        {
-          // The Schur complement approximation (block_preconditioner.h)
-          // needs the pressure mass matrix weighted by phi/mu and the
-          // diagonal of the mass-and-drag part c M of A,
-          // c = phi rho a0/dt + beta, plus its floor (schur_floor_factor).
-          const double phi            = state.phi;
-          const double mass_weight    = phi / mu * JxW;
-          const double c              = m.reaction;
-          const double spacing        = h / fe.degree;
-          double       viscous_number = c > 0 ?
-                                          m.diffusion / (c * spacing * spacing) :
-                                          std::numeric_limits<double>::infinity();
-          if (convection && c > 0)
-            viscous_number =
-              std::max(viscous_number,
-                       m.convection_weight * state.u.norm() / (c * spacing));
-          max_viscous_number = std::max(max_viscous_number, viscous_number);
-          cell_drag += state.beta * JxW;
-          cell_viscosity += m.diffusion * JxW;
-          max_beta = std::max(max_beta, state.beta);
-          for (unsigned int b = 0; b < n_p; ++b)
-            for (unsigned int e = 0; e < n_p; ++e)
-              integrals.Mp[b * n_p + e] +=
-                mass_weight * shapes.Np[b] * shapes.Np[e];
-          for (unsigned int a = 0; a < n_s; ++a)
-          {
-            double g = 0;
-            for (unsigned int d = 0; d < dim; ++d)
-              g += G[d][a] * G[d][a];
-            integrals.R[a] +=
-              w_mass * N[a] * N[a] + floor_factor * w_viscous * g;
-          }
-        }
+          integrate_schur_pieces(m,
+                                 state,
+                                 shapes,
+                                 JxW_values[q],
+                                 mu,
+                                 h / fe.degree,
+                                 floor_factor,
+                                 convection,
+                                 integrals,
+                                 schur,
+                                 max_beta);
       }
+      max_viscous_number =
+        std::max(max_viscous_number, schur.max_viscous_number);
 
       // Grains at points and boundary faces.
       if (!terms.on_cells.empty())
@@ -522,35 +671,8 @@ namespace ImmersedGrains
           term->cell(context, integrals);
       }
 
-      // The scalar integrals onto the vector-valued cell matrix.
-      cell_matrix = 0;
-      for (unsigned int c = 0; c < dim; ++c)
-        for (unsigned int a = 0; a < n_s; ++a)
-        {
-          const unsigned int i = velocity_dof[a][c];
-          cell_rhs(i)          = integrals.rhs_u[a * dim + c];
-          for (unsigned int b = 0; b < n_s; ++b)
-            cell_matrix(i, velocity_dof[b][c]) = integrals.K[a * n_s + b];
-          if (convection_derivative)
-            for (unsigned int d = 0; d < dim; ++d)
-              for (unsigned int b = 0; b < n_s; ++b)
-                cell_matrix(i, velocity_dof[b][d]) +=
-                  integrals.W[(c * dim + d) * n_s * n_s + a * n_s + b];
-          for (unsigned int b = 0; b < n_p; ++b)
-          {
-            const double value = integrals.B[(c * n_s + a) * n_p + b];
-            cell_matrix(i, pressure_dof[b]) = value;
-            cell_matrix(pressure_dof[b], i) = value;
-          }
-        }
-      for (unsigned int b = 0; b < n_p; ++b)
-      {
-        cell_rhs(pressure_dof[b]) = integrals.rhs_p[b];
-        for (unsigned int e = 0; e < n_p; ++e)
-          cell_matrix(pressure_dof[b], pressure_dof[e]) =
-            integrals.C[b * n_p + e];
-      }
-
+      fill_cell_system(
+        integrals, dofs, convection_derivative, cell_matrix, cell_rhs);
       const bool direct = cell_scatter->is_direct(cell_number);
       if (!direct || assemble_preconditioner_matrices)
         cell->get_dof_indices(dof_indices);
@@ -564,16 +686,16 @@ namespace ImmersedGrains
         cell_reaction = 0;
         for (unsigned int b = 0; b < n_p; ++b)
         {
-          pressure_indices[b] = dof_indices[pressure_dof[b]];
+          pressure_indices[b] = dof_indices[dofs.pressure[b]];
           for (unsigned int e = 0; e < n_p; ++e)
             cell_mass(b, e) = integrals.Mp[b * n_p + e];
         }
         for (unsigned int a = 0; a < n_s; ++a)
           for (unsigned int c = 0; c < dim; ++c)
-            cell_reaction(velocity_dof[a][c]) = integrals.R[a];
-        if (cell_drag > 0)
-          cell_mass *=
-            drag_cell_mass_factor(cell_drag * h * h / cell_viscosity);
+            cell_reaction(dofs.velocity[a][c]) = integrals.R[a];
+        if (schur.cell_drag > 0)
+          cell_mass *= drag_cell_mass_factor(schur.cell_drag * h * h /
+                                             schur.cell_viscosity);
         pressure_mass_constraints.distribute_local_to_global(
           cell_mass, pressure_indices, pressure_mass_matrix);
         update_constraints.distribute_local_to_global(cell_reaction,

@@ -82,7 +82,7 @@ namespace ImmersedGrains
     // the constant on every component, gives each aggregate the mode it
     // has: the same aggregates, the preconditioner benchmark's builds
     // 20-40 % and its solves 12-40 % cheaper for 0.8 % more iterations
-    // (doc/performance.md, eleventh round). A rank without DoFs gets no
+    // (doc/performance.md). A rank without DoFs gets no
     // modes from extract_constant_modes.
     if (!velocity_components_coupled() &&
         !settings.velocity_constant_modes.empty())
@@ -182,7 +182,7 @@ namespace ImmersedGrains
       // (10^10 and more between clear fluid and a packed bed), and a
       // millionth of the mean diagonal swamped the rows of the drag
       // region, where S_c^{-1} then lost its Darcy term
-      // (doc/benchmarks.md, fifth round: 186 instead of 33 iterations).
+      // (doc/benchmarks.md: 186 instead of 33 iterations).
       if (schur_diagonal_matrix.m() != product.m())
       {
         dealii::TrilinosWrappers::SparsityPattern pattern(owned_partitioning[1],

@@ -19,6 +19,7 @@
 #include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/coarse_schur_correction.h>
 #include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/io/statistics.h>
 #include <immersed_grains/parameters.h>
 
 namespace ImmersedGrains
@@ -1122,6 +1123,32 @@ namespace ImmersedGrains
   FluidSolver<dim>::get_time() const
   {
     return time;
+  }
+
+
+  template <int dim>
+  std::vector<std::string>
+  FluidSolver<dim>::StepStatistics::column_names()
+  {
+    return {"fluid_iterations",
+            "fluid_nonlinear_iterations",
+            "fluid_residual",
+            "drag_averaged_cells",
+            "preconditioner_builds"};
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::StepStatistics::set_statistics(
+    Statistics        &statistics,
+    const unsigned int builds_so_far) const
+  {
+    statistics.set("fluid_iterations", linear_iterations);
+    statistics.set("fluid_nonlinear_iterations", nonlinear_iterations);
+    statistics.set("fluid_residual", final_residual);
+    statistics.set("drag_averaged_cells", drag_averaged_cells);
+    statistics.set("preconditioner_builds", builds_so_far);
   }
 
 

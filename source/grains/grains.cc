@@ -4,6 +4,7 @@
 #include <deal.II/numerics/rtree.h>
 
 #include <immersed_grains/grains/grains.h>
+#include <immersed_grains/io/statistics.h>
 
 #include <algorithm>
 #include <cmath>
@@ -612,6 +613,77 @@ namespace ImmersedGrains
   }
 
 
+  std::vector<std::string>
+  GrainStepReport::column_names()
+  {
+    return {"max_overlap",
+            "contacts",
+            "contact_iterations",
+            "contact_residual",
+            "contact_converged",
+            "max_contact_force",
+            "alert_distance"};
+  }
+
+
+  void
+  GrainStepReport::set_statistics(Statistics &statistics) const
+  {
+    statistics.set("max_overlap", contacts.max_overlap);
+    statistics.set("contacts", contacts.n_active);
+    statistics.set("contact_iterations", contacts.iterations);
+    statistics.set("contact_residual", contacts.residual);
+    statistics.set("contact_converged", contacts.converged);
+    statistics.set("max_contact_force", max_contact_force);
+    statistics.set("alert_distance", alert_distance);
+  }
+
+
+  template <int dim>
+  std::vector<std::string>
+  GrainStatistics<dim>::column_names()
+  {
+    const char              *axes[] = {"x", "y", "z"};
+    std::vector<std::string> c      = {"particles", "solid_volume"};
+    for (unsigned int d = 0; d < dim; ++d)
+      c.push_back(std::string("centroid_") + axes[d]);
+    for (unsigned int d = 0; d < dim; ++d)
+      c.push_back(std::string("mean_velocity_") + axes[d]);
+    for (const char *name :
+         {"max_speed", "kinetic_energy", "packing_fraction", "grains_removed"})
+      c.emplace_back(name);
+    c.emplace_back("fixed_particles");
+    for (unsigned int d = 0; d < dim; ++d)
+      c.push_back(std::string("fixed_centroid_") + axes[d]);
+    return c;
+  }
+
+
+  template <int dim>
+  void
+  GrainStatistics<dim>::set_statistics(Statistics &statistics,
+                                       const bool  without_fluid) const
+  {
+    const char *axes[] = {"x", "y", "z"};
+    statistics.set("particles", n_grains);
+    if (without_fluid)
+      statistics.set("solid_volume", solid_volume);
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      statistics.set(std::string("centroid_") + axes[d], centroid[d]);
+      statistics.set(std::string("mean_velocity_") + axes[d], mean_velocity[d]);
+    }
+    statistics.set("fixed_particles", n_fixed);
+    for (unsigned int d = 0; d < dim; ++d)
+      statistics.set(std::string("fixed_centroid_") + axes[d],
+                     fixed_centroid[d]);
+    statistics.set("max_speed", max_speed);
+    statistics.set("kinetic_energy", kinetic_energy);
+    statistics.set("packing_fraction", packing_fraction);
+    statistics.set("grains_removed", n_removed);
+  }
+
+
   template <int dim>
   GrainStepReport
   Grains<dim>::resolve_contacts(const double dt, const bool add_to_step_impulse)
@@ -1025,6 +1097,7 @@ namespace ImmersedGrains
       s.packing_fraction =
         height > 0 ? s.solid_volume / (section * 2 * height) : 0;
     }
+    s.n_removed = removed_total;
     return s;
   }
 
@@ -1067,4 +1140,6 @@ namespace ImmersedGrains
   make_grain_property_layout(const GrainParameters<3> &, bool, bool);
   template class Grains<2>;
   template class Grains<3>;
+  template struct GrainStatistics<2>;
+  template struct GrainStatistics<3>;
 } // namespace ImmersedGrains

@@ -12,6 +12,25 @@
 
 namespace ImmersedGrains
 {
+  namespace
+  {
+    std::vector<std::string>
+    split_row(const std::string &line)
+    {
+      std::vector<std::string> cells;
+      std::string::size_type   start = 0;
+      for (;;)
+      {
+        const auto comma = line.find(',', start);
+        cells.push_back(line.substr(start, comma - start));
+        if (comma == std::string::npos)
+          return cells;
+        start = comma + 1;
+      }
+    }
+  } // namespace
+
+
   Statistics::Statistics(std::vector<std::string> columns)
       : columns(std::move(columns))
   {
@@ -37,13 +56,30 @@ namespace ImmersedGrains
         std::ifstream old(file_name);
         std::ofstream kept(part);
         std::string   line;
-        std::getline(old, line); // the old header, written anew below
+        // The old header: its rows are written in this table's column
+        // order, which a file of another version may not share (a column
+        // it lacks is left empty).
+        std::getline(old, line);
+        const std::vector<std::string> old_columns = split_row(line);
+        std::vector<int>               source(columns.size(), -1);
+        for (unsigned int i = 0; i < columns.size(); ++i)
+          for (unsigned int k = 0; k < old_columns.size(); ++k)
+            if (old_columns[k] == columns[i])
+              source[i] = k;
         for (unsigned int i = 0; i < columns.size(); ++i)
           kept << (i ? "," : "") << columns[i];
         kept << '\n';
         while (std::getline(old, line))
           if (!line.empty() && std::stod(line) <= keep_through_step)
-            kept << line << '\n';
+          {
+            const std::vector<std::string> cells = split_row(line);
+            for (unsigned int i = 0; i < columns.size(); ++i)
+              kept << (i ? "," : "")
+                   << (source[i] >= 0 && source[i] < int(cells.size()) ?
+                         cells[source[i]] :
+                         std::string());
+            kept << '\n';
+          }
         AssertThrow(kept, dealii::ExcMessage("Cannot write " + part));
       }
       std::filesystem::rename(part, file_name);

@@ -255,6 +255,32 @@ namespace ImmersedGrains
       double                        dt,
       bool                          free) const;
 
+    /// One grain's drag, the one evaluation of the law that the fluid's
+    /// implicit drag (prepare_fluid_drag()) and the grains' later sub-steps
+    /// (set_hooks()) share: gamma_i at the slip of grain @p i against the
+    /// velocity it feels, @p felt, and the fluid fraction it feels, both
+    /// without its own disturbance where the correction is on
+    /// (undisturbed()); whether its contacts hold it, with the drag mass
+    /// m + dt gamma of a step @p dt; its disturbance relaxed over @p dt, or
+    /// kept where @p frozen (a later sub-step in the same fluid).
+    struct GrainDrag
+    {
+      double                 gamma    = 0;
+      double                 reynolds = 0;
+      dealii::Tensor<1, dim> self;
+      bool                   held = false;
+    };
+    GrainDrag
+    grain_drag(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const dealii::Point<dim>     &reference,
+      const GrainStepArrays<dim>   &arrays,
+      unsigned int                  i,
+      double                        felt_fraction,
+      const dealii::Tensor<1, dim> &felt,
+      double                        dt,
+      bool                          frozen) const;
+
     /// Whether grain @p i is held by its contacts: it kept at most
     /// Resting threshold of the velocity its last contact impulse removed
     /// from its @p drag_mass (m + dt gamma).

@@ -56,12 +56,12 @@ namespace ImmersedGrains
       // The AMG's aggregation threshold for A: the strength below which a
       // coupling is dropped when the aggregates are formed. 0.05 suits the
       // 2D Q2 blocks; in 3D it doubled the set-up at 10^5 DoFs
-      // (doc/performance.md, eighth round).
+      // (doc/performance.md).
       double velocity_aggregation_threshold = 0.02;
       // Symmetric Gauss-Seidel instead of ILU on the AMG's coarser levels:
       // in 3D their operators hold about 200 entries per row, whose ILU
       // cost more to set up than the finest level's (doc/performance.md,
-      // eighth round).
+      // preconditioner benchmarks).
       bool velocity_coarse_gauss_seidel = false;
 
       // Constant modes of the velocity components (near null space of A).

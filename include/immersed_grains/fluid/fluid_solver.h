@@ -25,6 +25,7 @@
 
 namespace ImmersedGrains
 {
+  class Statistics;
   class BlockSchurPreconditioner;
   class CoarseSchurCorrection;
   template <int dim>
@@ -157,6 +158,14 @@ namespace ImmersedGrains
       unsigned int drag_averaged_cells = 0;
       // Preconditioners built in this step (0: the kept one served).
       unsigned int preconditioner_builds = 0;
+
+      /** The statistics columns of a fluid step (doc/output.md). */
+      static std::vector<std::string>
+      column_names();
+      /** @p builds_so_far: preconditioners built since the start (the
+       *  column is cumulative). */
+      void
+      set_statistics(Statistics &statistics, unsigned int builds_so_far) const;
     };
 
     /** Advances from the current time to @p new_time = time + dt. A step
@@ -297,7 +306,7 @@ namespace ImmersedGrains
     // and the Cartesian map is exact for them at a fraction of MappingQ1's
     // cost (constant Jacobians, a closed-form inverse; MappingQ1 also
     // rebuilt its support points for every FEValues object,
-    // doc/performance.md, eighth round).
+    // doc/performance.md).
     dealii::MappingCartesian<dim> mapping;
     std::vector<dealii::IndexSet> owned_partitioning;
     std::vector<dealii::IndexSet> relevant_partitioning;

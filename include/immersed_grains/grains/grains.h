@@ -22,6 +22,8 @@
 
 namespace ImmersedGrains
 {
+  class Statistics;
+
   /**
    * Where each quantity sits among a particle's properties. Only what the
    * scene needs is stored: velocity and radius always (the mass follows
@@ -138,6 +140,15 @@ namespace ImmersedGrains
      *  never change). */
     double             n_fixed = 0;
     dealii::Point<dim> fixed_centroid;
+    /** Grains that left through open faces since the start. */
+    double n_removed = 0;
+
+    /** The statistics columns these fill (doc/output.md); solid_volume
+     *  only @p without_fluid (else the coupling's projection). */
+    static std::vector<std::string>
+    column_names();
+    void
+    set_statistics(Statistics &statistics, bool without_fluid) const;
   };
 
   /**
@@ -166,6 +177,12 @@ namespace ImmersedGrains
      *  kept, the contact count is the last sub-step's. */
     void
     add_substep(const GrainStepReport &later);
+
+    /** The statistics columns of a step's contacts (doc/output.md). */
+    static std::vector<std::string>
+    column_names();
+    void
+    set_statistics(Statistics &statistics) const;
   };
 
   /**

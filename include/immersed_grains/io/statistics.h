@@ -10,9 +10,10 @@
 namespace ImmersedGrains
 {
   /**
-   * The per-step table written to statistics.csv: a fixed column order set
-   * once (the core columns, step to wall_time, first: see
-   * statistics_columns() in source/simulation.cc), one row per call to
+   * The per-step table written to statistics.csv: a column order set once
+   * (the core columns, step to wall_time, first, then those each object
+   * declares: Simulation::statistics_columns() in
+   * source/simulation/statistics.cc), one row per call to
    * write_row(). Only rank 0 writes; the row is flushed at once so that a
    * run that stops early still leaves its history.
    */

@@ -1,0 +1,323 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <immersed_grains/coupling/coupled_step.h>
+#include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/grains/grains.h>
+#include <immersed_grains/io/progress_line.h>
+#include <immersed_grains/simulation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace ImmersedGrains
+{
+  namespace
+  {
+    // The timings.csv columns and the TimerOutput sections each one sums.
+    const std::vector<std::pair<std::string, std::vector<std::string>>> &
+    timing_phases()
+    {
+      static const std::vector<std::pair<std::string, std::vector<std::string>>>
+        phases = {{"setup", {"mesh", "fluid: setup", "grains: setup"}},
+                  {"assembly", {"fluid: assembly"}},
+                  {"preconditioner", {"fluid: preconditioner"}},
+                  {"solve", {"fluid: solve", "fluid: direct solve"}},
+                  {"solid_fraction", {"coupling: solid fraction"}},
+                  {"interaction_force", {"coupling: interaction force"}},
+                  {"grain_velocities",
+                   {"grains: free velocities", "grains: gather"}},
+                  {"contacts", {"grains: contacts"}},
+                  {"sort", {"grains: move and sort"}},
+                  {"adaptation", {"adaptation"}},
+                  {"output", {"output"}},
+                  {"statistics", {"statistics"}}};
+      return phases;
+    }
+
+    // The interface's core columns, in their documented order
+    // (doc/output.md): first in the file, whoever fills them.
+    std::vector<std::string>
+    core_columns(const unsigned int dim)
+    {
+      std::vector<std::string> c = {
+        "step", "time", "dt", "particles", "solid_volume"};
+      const char *axes[] = {"x", "y", "z"};
+      for (unsigned int d = 0; d < dim; ++d)
+        c.push_back(std::string("centroid_") + axes[d]);
+      for (unsigned int d = 0; d < dim; ++d)
+        c.push_back(std::string("mean_velocity_") + axes[d]);
+      for (const char *name : {"max_speed",
+                               "kinetic_energy",
+                               "max_overlap",
+                               "contacts",
+                               "contact_iterations",
+                               "fluid_iterations",
+                               "cells",
+                               "dofs",
+                               "wall_time"})
+        c.emplace_back(name);
+      return c;
+    }
+  } // namespace
+
+
+  template <int dim>
+  std::vector<std::string>
+  Simulation<dim>::statistics_columns()
+  {
+    // Each object declares the columns it fills.
+    const std::vector<std::vector<std::string>> owners = {
+      // The run (postprocess()): load_imbalance is the most loaded rank
+      // over the mean, cells and grains weighted as for partitioning (1 on
+      // one rank or without grains); step_retries, the fluid steps taken
+      // again shorter after a failure, since the start.
+      {"step",
+       "time",
+       "dt",
+       "cells",
+       "wall_time",
+       "load_imbalance",
+       "step_retries"},
+      GrainStatistics<dim>::column_names(),
+      GrainStepReport::column_names(),
+      FluidSolver<dim>::StepStatistics::column_names(),
+      // The mixture's fields (set_fluid_statistics()).
+      {"dofs",
+       "fluid_volume",
+       "pressure_drop",
+       "solid_volume",
+       "solid_volume_error",
+       "max_reynolds"},
+      CoupledStep<dim>::column_names(),
+      CloudAnalysis<dim>::column_names()};
+    std::vector<std::string> columns = core_columns(dim);
+    for (const auto &names : owners)
+      for (const auto &name : names)
+        if (std::find(columns.begin(), columns.end(), name) == columns.end())
+          columns.push_back(name);
+    return columns;
+  }
+
+
+  template <int dim>
+  std::vector<std::string>
+  Simulation<dim>::timing_columns()
+  {
+    std::vector<std::string> c = {"step", "time"};
+    for (const auto &phase : timing_phases())
+      c.push_back(phase.first);
+    c.emplace_back("other");
+    c.emplace_back("total");
+    return c;
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::postprocess(const double dt)
+  {
+    dealii::TimerOutput::Scope scope(*timer, "statistics");
+    statistics.set("step", step);
+    statistics.set("time", time);
+    statistics.set("dt", dt);
+    statistics.set("cells", triangulation.n_global_active_cells());
+    statistics.set("load_imbalance",
+                   load_balance ? load_balance->imbalance() : 1.0);
+    statistics.set("step_retries", retries_taken);
+    if (fluid)
+      set_fluid_statistics();
+    if (grains)
+      set_grain_statistics();
+    statistics.set("wall_time", wall_clock() - wall_start);
+    statistics.write_row();
+
+    print_test_row(false);
+    pdetail << "step " << step << " t=" << time << " dt=" << dt;
+    if (fluid)
+      pdetail << " fluid iterations=" << statistics.get("fluid_iterations");
+    if (grains)
+      pdetail << " grains=" << grain_statistics->n_grains
+              << " contacts=" << statistics.get("contacts")
+              << " sweeps=" << statistics.get("contact_iterations")
+              << " Ekin=" << grain_statistics->kinetic_energy;
+    pdetail << '\n';
+    print_progress(false);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::set_fluid_statistics()
+  {
+    double volume = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      volume *= geometry.upper_corner[d] - geometry.lower_corner[d];
+    // The coupling knows its fluid fraction node by node; prescribed
+    // fields are integrated by quadrature.
+    const double fluid_volume = coupling && coupling_parameters.two_way ?
+                                  coupling->fluid_volume() :
+                                  fluid->integrate_fluid_fraction();
+    statistics.set("dofs", fluid->n_dofs());
+    statistics.set("fluid_volume", fluid_volume);
+    if (!pressure_drop_points.empty())
+      statistics.set("pressure_drop",
+                     fluid->pressure_at(pressure_drop_points[0]) -
+                       fluid->pressure_at(pressure_drop_points[1]));
+    statistics.set("solid_volume",
+                   coupling ? coupling->solid_volume() : volume - fluid_volume);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::set_grain_statistics()
+  {
+    if (!grain_statistics)
+      grain_statistics = std::make_unique<GrainStatistics<dim>>();
+    *grain_statistics = grains->compute_statistics();
+    const auto &s     = *grain_statistics;
+    s.set_statistics(statistics, !fluid);
+    if (coupling && s.solid_volume > 0)
+    {
+      // Conservation of the projection: what the fluid sees against what
+      // the grains are.
+      statistics.set("solid_volume_error",
+                     std::abs(coupling->solid_volume() - s.solid_volume) /
+                       s.solid_volume);
+      statistics.set("max_reynolds", coupling->max_reynolds());
+    }
+    if (cloud_analysis)
+      set_cloud_statistics();
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::set_cloud_statistics()
+  {
+    const CloudMeasures<dim> m =
+      cloud_analysis->analyse(grains->particle_handler(),
+                              grains->layout(),
+                              2 * largest_grain_radius);
+    const char *axes[] = {"x", "y", "z"};
+    statistics.set("cloud_grains", m.n_cloud_grains);
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      statistics.set(std::string("cloud_centroid_") + axes[d], m.centroid[d]);
+      statistics.set(std::string("cloud_velocity_") + axes[d], m.velocity[d]);
+      statistics.set(std::string("cloud_extent_") + axes[d], m.extent[d]);
+    }
+    statistics.set("leaked", m.n_leaked);
+    statistics.set("clusters", m.n_clusters);
+    if (m.n_clusters > cloud_parameters.placed_clouds && breakup_time < 0)
+    {
+      breakup_time = time;
+      pcout << "The cloud has broken up at t = " << time << " s (step " << step
+            << "): " << m.n_clusters << " clusters of at least "
+            << cloud_parameters.minimum_cluster_fraction * 100
+            << " % of the grains each, " << m.n_leaked
+            << " grains outside the largest\n";
+    }
+    statistics.set("breakup_time", breakup_time);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::print_progress(const bool last)
+  {
+    if (!progress->due(last))
+      return;
+    std::ostringstream line;
+    line << std::setprecision(3);
+    if (fluid)
+      line << " (dt " << statistics.get("dt");
+    if (fluid && grains)
+      line << ", " << static_cast<long long>(statistics.get("grain_substeps"))
+           << " grain sub-steps";
+    if (fluid)
+      line << ")";
+    // Counts as integers (a double stream would write 1.04e+03).
+    const auto count = [this](const char *column)
+    { return static_cast<long long>(statistics.get(column)); };
+    if (grains)
+      line << ", " << count("particles") << " grains";
+    line << ", " << count("cells") << " cells";
+    if (fluid)
+      line << ", " << count("fluid_iterations") << " fluid its";
+    if (grains && grain_parameters.contacts_enabled)
+      line << ", " << count("contact_iterations") << " sweeps";
+    progress->print(time, end_time, step, line.str(), last);
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::record_timings()
+  {
+    // Wall seconds spent in each phase since the last row, the slowest
+    // rank's (a step waits for it).
+    const auto totals =
+      timer->get_summary_data(dealii::TimerOutput::total_wall_time);
+    std::vector<double> spent;
+    for (const auto &[column, sections] : timing_phases())
+    {
+      double sum = 0;
+      for (const auto &section : sections)
+        if (const auto it = totals.find(section); it != totals.end())
+          sum += it->second;
+      spent.push_back(sum - timer_totals[column]);
+      timer_totals[column] = sum;
+    }
+    const double wall = wall_clock();
+    spent.push_back(wall - last_timing_wall);
+    last_timing_wall = wall;
+    dealii::Utilities::MPI::max(dealii::ArrayView<const double>(spent),
+                                comm,
+                                dealii::ArrayView<double>(spent));
+
+    timings.set("step", step);
+    timings.set("time", time);
+    double phases = 0;
+    for (unsigned int i = 0; i < timing_phases().size(); ++i)
+    {
+      timings.set(timing_phases()[i].first, spent[i]);
+      phases += spent[i];
+    }
+    timings.set("total", spent.back());
+    timings.set("other", std::max(0.0, spent.back() - phases));
+    timings.write_row();
+  }
+
+
+  template <int dim>
+  void
+  Simulation<dim>::print_test_row(const bool last) const
+  {
+    if (!test_output || dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      return;
+    // Rows every Test every steps, the last one always (once).
+    const bool regular = step % test_every == 0;
+    if (last ? !regular : regular)
+      statistics.print(std::cout, test_columns);
+  }
+
+
+
+#define IMMERSED_GRAINS_INSTANTIATE(dim)                                         \
+  template std::vector<std::string> Simulation<dim>::statistics_columns();       \
+  template std::vector<std::string> Simulation<dim>::timing_columns();           \
+  template void                     Simulation<dim>::postprocess(double);        \
+  template void                     Simulation<dim>::set_fluid_statistics();     \
+  template void                     Simulation<dim>::set_grain_statistics();     \
+  template void                     Simulation<dim>::set_cloud_statistics();     \
+  template void                     Simulation<dim>::print_progress(bool);       \
+  template void                     Simulation<dim>::print_test_row(bool) const; \
+  template void                     Simulation<dim>::record_timings();
+
+  IMMERSED_GRAINS_INSTANTIATE(2)
+  IMMERSED_GRAINS_INSTANTIATE(3)
+} // namespace ImmersedGrains
