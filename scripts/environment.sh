@@ -14,3 +14,7 @@ export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.."
 # (relative to the base directory; for the debug information's working
 # directory) unless told not to: build/ and build-dev/ shared no object.
 export CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+# The build precompiles deal.II's common headers (CMakeLists.txt): ccache
+# caches such compilations only when told to overlook what a precompiled
+# header changes in its hashes (the ccache manual, "Precompiled headers").
+export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}
