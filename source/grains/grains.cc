@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 namespace ImmersedGrains
@@ -652,6 +653,8 @@ namespace ImmersedGrains
     for (const char *name :
          {"max_speed", "kinetic_energy", "packing_fraction", "grains_removed"})
       c.emplace_back(name);
+    for (unsigned int d = 0; d < dim; ++d)
+      c.push_back(std::string("grains_max_") + axes[d]);
     c.emplace_back("fixed_particles");
     for (unsigned int d = 0; d < dim; ++d)
       c.push_back(std::string("fixed_centroid_") + axes[d]);
@@ -681,6 +684,8 @@ namespace ImmersedGrains
     statistics.set("kinetic_energy", kinetic_energy);
     statistics.set("packing_fraction", packing_fraction);
     statistics.set("grains_removed", n_removed);
+    for (unsigned int d = 0; d < dim; ++d)
+      statistics.set(std::string("grains_max_") + axes[d], max_position[d]);
   }
 
 
@@ -1033,7 +1038,10 @@ namespace ImmersedGrains
                                                  geometry.upper_corner[axis];
     const unsigned int  fixed_sums = 3 + 2 * dim + 1;
     std::vector<double> sums(fixed_sums + 1 + dim, 0.);
-    double              max_speed = 0;
+    // The largest speed and the largest centre coordinates, reduced
+    // together.
+    std::vector<double> maxima(1 + dim, std::numeric_limits<double>::lowest());
+    maxima[0] = 0;
     for (const auto &p : particles)
     {
       const auto             props = p.get_properties();
@@ -1059,7 +1067,9 @@ namespace ImmersedGrains
       // Height above the floor the grains rest on (the face gravity points
       // to), weighted by volume.
       sums[3 + 2 * dim] += V * std::abs(p.get_location()[axis] - floor);
-      max_speed = std::max(max_speed, v.norm());
+      maxima[0] = std::max(maxima[0], v.norm());
+      for (unsigned int d = 0; d < dim; ++d)
+        maxima[1 + d] = std::max(maxima[1 + d], p.get_location()[d]);
       if (is_fixed(p))
       {
         sums[fixed_sums] += 1;
@@ -1073,12 +1083,14 @@ namespace ImmersedGrains
     s.n_grains       = sums[0];
     s.solid_volume   = sums[1];
     s.kinetic_energy = sums[2];
-    s.max_speed      = dealii::Utilities::MPI::max(max_speed, comm);
+    dealii::Utilities::MPI::max(maxima, comm, maxima);
+    s.max_speed = maxima[0];
     if (s.n_grains > 0)
       for (unsigned int d = 0; d < dim; ++d)
       {
         s.centroid[d]      = sums[3 + d] / s.n_grains;
         s.mean_velocity[d] = sums[3 + dim + d] / s.n_grains;
+        s.max_position[d]  = maxima[1 + d];
       }
     s.n_fixed = sums[fixed_sums];
     if (s.n_fixed > 0)

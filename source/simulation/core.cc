@@ -739,7 +739,7 @@ namespace ImmersedGrains
       if (coupling && coupling_parameters.grain_substeps)
       {
         // Multi-rate: the fluid follows the flow, the grains sub-step
-        // inside (solve_coupled_time_step).
+        // inside (CoupledStep::advance()).
         const double h = grains->shortest_cell_edge();
         const double v = grains->max_speed();
         if (v > 0)

@@ -142,6 +142,9 @@ namespace ImmersedGrains
     dealii::Point<dim> fixed_centroid;
     /** Grains that left through open faces since the start. */
     double n_removed = 0;
+    /** The largest coordinate of any grain's centre, per axis (run-outs,
+     *  bed heights; 0 without grains). */
+    dealii::Point<dim> max_position;
 
     /** The statistics columns these fill (doc/output.md); solid_volume
      *  only @p without_fluid (else the coupling's projection). */
