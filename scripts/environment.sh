@@ -10,11 +10,8 @@ export CCACHE_DIR=${CCACHE_DIR:-$HOME/.ccache}
 # Paths relative to the checkout in ccache's hashes: a second clone (CI's
 # fresh one) reuses the objects of the first.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}
-# deal.II's flags carry -g, and with -g ccache hashes the build directory
+# deal.II's Debug flags carry -g (Release ones too with
+# IMMERSED_GRAINS_DEBUG_INFO=ON), and with -g ccache hashes the build directory
 # (relative to the base directory; for the debug information's working
 # directory) unless told not to: build/ and build-dev/ shared no object.
 export CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
-# The build precompiles deal.II's common headers (CMakeLists.txt): ccache
-# caches such compilations only when told to overlook what a precompiled
-# header changes in its hashes (the ccache manual, "Precompiled headers").
-export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}

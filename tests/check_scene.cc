@@ -96,7 +96,7 @@ check(const std::string &name,
   std::cout << name << ": exit status " << (status == 0 ? "0" : "non-zero")
             << ", output directory "
             << (fs::exists("out_" + name) ? "written" : "absent") << '\n';
-  std::ifstream out("stdout_" + name);
+  std::ifstream    out("stdout_" + name);
   const std::regex small("([0-9.]+)e(-[0-9][0-9]+)");
   for (std::string line; std::getline(out, line);)
     std::cout << std::regex_replace(line, small, "$1 x 10^$2") << '\n';

@@ -15,16 +15,16 @@
 // 0.1 % of the distance fallen of the straight two-rank run (one rank and
 // two split the contact sweeps differently and so round differently; the
 // window holds that round-off as the contacts amplify it). The same again
-// with Adaptivity/Every steps = auto, whose schedule depends on the grains' travel since the last
-// adaptation: that sum must survive the restart; and with Band lookahead,
-// whose schedule depends on when the band was made and on each grain's
-// deviation from its straight path. Last, a fresh run in a
-// directory that holds another run's checkpoints keeps only its own, and
-// a resume with other physics (friction added) stops with an input error
-// that names Checkpoint/Resume and leaves the run as it was, and so does a
-// resume with the band's lookahead from sets written before physics.txt
-// (the same sets with the file taken away), and a resume of sets whose
-// grains carry a layout no setting gives (another version's) says so.
+// with Adaptivity/Every steps = auto, whose schedule depends on the grains'
+// travel since the last adaptation: that sum must survive the restart; and with
+// Band lookahead, whose schedule depends on when the band was made and on each
+// grain's deviation from its straight path. Last, a fresh run in a directory
+// that holds another run's checkpoints keeps only its own, and a resume with
+// other physics (friction added) stops with an input error that names
+// Checkpoint/Resume and leaves the run as it was, and so does a resume with the
+// band's lookahead from sets written before physics.txt (the same sets with the
+// file taken away), and a resume of sets whose grains carry a layout no setting
+// gives (another version's) says so.
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 

@@ -198,10 +198,7 @@ namespace
                       mu == 0 ? "(E_cm + E_spin)/E - 1" : "E_cm/E - 1",
                       ok ? "OK" : "FAILED");
           if (!ok)
-            std::fprintf(stderr,
-                         "dE/E = %g, lower bound %g\n",
-                         change,
-                         lowest);
+            std::fprintf(stderr, "dE/E = %g, lower bound %g\n", change, lowest);
         }
   }
 } // namespace

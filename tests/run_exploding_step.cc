@@ -3,10 +3,10 @@
 // its velocity grows without bound, and the adaptive step shrinks with it
 // (to 1e-80 s by t = 2.27 s, where the run would sit for ever: time no
 // longer advances, and the velocity, 1e78 m/s, is still finite). The
-// divergence check (DivergenceGuard::find_speeding, source/divergence_guard.cc) stops it once
-// a speed exceeds 100 times the fastest motion the scene drives, here free
-// fall across the unit box, sqrt(2 g) = 4.43 m/s: one line on stderr naming
-// the step and the speed, a non-zero exit status, a last output of that
+// divergence check (DivergenceGuard::find_speeding, source/divergence_guard.cc)
+// stops it once a speed exceeds 100 times the fastest motion the scene drives,
+// here free fall across the unit box, sqrt(2 g) = 4.43 m/s: one line on stderr
+// naming the step and the speed, a non-zero exit status, a last output of that
 // step. The same cavity with the lid at 1 mm/s and a viscosity that
 // resolves it runs to its end with the check on.
 #include <cstdlib>
