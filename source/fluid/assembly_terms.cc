@@ -386,7 +386,7 @@ namespace ImmersedGrains
   bool
   BoundaryFluxTerm<dim>::needed(const Geometry<dim> &geometry)
   {
-    for (const BoundaryType type : geometry.boundary_types)
+    for (const auto &[id, type] : geometry.boundary_types)
       if (type == BoundaryType::open || type == BoundaryType::velocity)
         return true;
     return false;
@@ -404,7 +404,7 @@ namespace ImmersedGrains
       const auto face = cell->face(face_no);
       if (!face->at_boundary())
         continue;
-      const BoundaryType type = geometry.boundary_types[face->boundary_id()];
+      const BoundaryType type = geometry.boundary_type(face->boundary_id());
       if (type != BoundaryType::open && type != BoundaryType::velocity)
         continue;
       fe_face_values.reinit(cell, face_no);

@@ -466,9 +466,7 @@ namespace ImmersedGrains
     coarsest = -dealii::Utilities::MPI::max(-coarsest, mpi_communicator);
     int level =
       std::min<int>(parameters.coarse_correction_refinement, coarsest - 1);
-    std::size_t cells = 1;
-    for (unsigned int d = 0; d < dim; ++d)
-      cells *= geometry.subdivisions[d];
+    const std::size_t cells = geometry.n_coarse_cells();
     while (level >= 0 && (cells << (dim * level)) > (dim == 2 ? 4096u : 512u))
       --level;
     return level;

@@ -94,6 +94,14 @@ namespace ImmersedGrains
                         Bool(),
                         "Solve the averaged fluid. Without it grains move in "
                         "vacuum (dry granular scenes).");
+      prm.declare_entry(
+        "Inflow velocity",
+        "",
+        Anything(),
+        "The fluid velocity on 'inflow' (or 'velocity') boundaries: one "
+        "expression per component separated by ';', each a function of x, "
+        "y[, z] and t (deal.II FunctionParser), e.g. '0; 6*x*(1-x)'. Empty: "
+        "the subsection Boundary velocity gives it (zero by default).");
       prm.declare_entry("Density",
                         "1000",
                         Double(),
@@ -330,7 +338,16 @@ namespace ImmersedGrains
     const InputLocation where{file, "Fluid"};
     prm.enter_subsection("Fluid");
     {
-      enabled   = prm.get_bool("Enabled");
+      enabled = prm.get_bool("Enabled");
+      // The assembly scales the reference cell's gradients by each cell's
+      // extents (fluid_assembly.cc), exact only on axis-parallel boxes.
+      where.require(!enabled || geometry.is_cartesian(),
+                    "Enabled",
+                    prm.get("Enabled"),
+                    "the fluid needs a mesh of axis-parallel cells, and " +
+                      geometry.mesh_file +
+                      " has others (grains alone run on it: Enabled = "
+                      "false)");
       density   = prm.get_double("Density");
       viscosity = prm.get_double("Viscosity");
       where.require(density > 0,
@@ -387,9 +404,10 @@ namespace ImmersedGrains
           prm.get_double("Preconditioner rebuild ratio");
         const std::string coarse = prm.get("Coarse correction");
         coarse_correction =
-          coarse == "true" ||
-          (coarse == "auto" && dim == 2 && !time_derivative &&
-           geometry.longest_side() >= 2 * geometry.shortest_side());
+          geometry.is_box() &&
+          (coarse == "true" ||
+           (coarse == "auto" && dim == 2 && !time_derivative &&
+            geometry.longest_side() >= 2 * geometry.shortest_side()));
         coarse_correction_refinement =
           prm.get_integer("Coarse correction refinement");
         where.require(velocity_inner_tolerance < 1,
@@ -398,6 +416,19 @@ namespace ImmersedGrains
                       "must be below 1");
       }
       prm.leave_subsection();
+      const std::string        inflow_text = prm.get("Inflow velocity");
+      dealii::ParameterHandler inflow_entry;
+
+      // Read through a ParameterHandler of its own, so that its expression
+      // is checked as the subsections' are, below.
+      if (!inflow_text.empty())
+      {
+        inflow_entry.enter_subsection("Inflow velocity");
+        dealii::Functions::ParsedFunction<dim>::declare_parameters(inflow_entry,
+                                                                   dim);
+        inflow_entry.set("Function expression", inflow_text);
+        inflow_entry.leave_subsection();
+      }
 
       std::shared_ptr<dealii::Functions::ParsedFunction<dim>> *targets[] = {
         &fluid_fraction,
@@ -407,10 +438,15 @@ namespace ImmersedGrains
         &boundary_velocity,
         &open_boundary_pressure,
         &initial_velocity};
-      unsigned int i = 0;
+      unsigned int              i     = 0;
+      dealii::ParameterHandler &outer = prm;
       for (const FieldEntry &f : field_entries)
       {
-        prm.enter_subsection(f.name);
+        const bool inflow =
+          targets[i] == &boundary_velocity && !inflow_text.empty();
+        dealii::ParameterHandler &prm  = inflow ? inflow_entry : outer;
+        const std::string         name = inflow ? "Inflow velocity" : f.name;
+        prm.enter_subsection(name);
         auto function =
           std::make_shared<dealii::Functions::ParsedFunction<dim>>(
             f.vector_valued ? dim : 1);
@@ -442,7 +478,7 @@ namespace ImmersedGrains
             d->print_info(info);
             message = info.str();
           }
-          where.fail(std::string(f.name) + "/Function expression",
+          where.fail(inflow ? name : name + "/Function expression",
                      prm.get("Function expression"),
                      message);
         }

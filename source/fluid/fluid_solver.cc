@@ -485,9 +485,8 @@ namespace ImmersedGrains
     const auto velocity_mask = fe.component_mask(velocities);
 
     std::set<dealii::types::boundary_id> slip_faces;
-    for (unsigned int f = 0; f < 2 * dim; ++f)
-      if (geometry.boundary_types[f] == BoundaryType::slip)
-        slip_faces.insert(f);
+    for (const auto id : geometry.boundary_ids(BoundaryType::slip))
+      slip_faces.insert(id);
 
     boundary_velocity->set_time(time);
     const VelocityOfSystem<dim>                prescribed(*boundary_velocity);
@@ -505,12 +504,12 @@ namespace ImmersedGrains
         if (geometry.is_periodic(d))
           dealii::DoFTools::make_periodicity_constraints(
             dof_handler, 2 * d, 2 * d + 1, d, c);
-      for (unsigned int f = 0; f < 2 * dim; ++f)
+      for (const auto &[f, type] : geometry.boundary_types)
       {
-        if (geometry.boundary_types[f] == BoundaryType::wall)
+        if (type == BoundaryType::wall)
           dealii::VectorTools::interpolate_boundary_values(
             mapping, dof_handler, f, zero, c, velocity_mask);
-        else if (geometry.boundary_types[f] == BoundaryType::velocity)
+        else if (type == BoundaryType::velocity)
           dealii::VectorTools::interpolate_boundary_values(
             mapping,
             dof_handler,
@@ -717,9 +716,7 @@ namespace ImmersedGrains
       steps_done       = steps_before;
       // Its preconditioner was built for the failed step.
       rebuild_requested = true;
-      if (std::find(geometry.boundary_types.begin(),
-                    geometry.boundary_types.end(),
-                    BoundaryType::velocity) != geometry.boundary_types.end())
+      if (geometry.has_velocity_boundary())
         make_constraints();
       throw FluidStepFailure(what);
     }
@@ -753,9 +750,7 @@ namespace ImmersedGrains
 
     // Start from the extrapolated state and the new boundary data (only
     // velocity faces carry data that depends on time).
-    if (std::find(geometry.boundary_types.begin(),
-                  geometry.boundary_types.end(),
-                  BoundaryType::velocity) != geometry.boundary_types.end())
+    if (geometry.has_velocity_boundary())
     {
       dealii::TimerOutput::Scope scope(timer, "fluid: setup");
       make_constraints();
@@ -1049,7 +1044,7 @@ namespace ImmersedGrains
       if (cell->is_locally_owned() && cell->at_boundary())
         for (const unsigned int f : cell->face_indices())
           if (cell->at_boundary(f) &&
-              geometry.boundary_types[cell->face(f)->boundary_id()] ==
+              geometry.boundary_type(cell->face(f)->boundary_id()) ==
                 BoundaryType::open)
             for (const unsigned int v : cell->face(f)->vertex_indices())
               max_open_pressure =

@@ -24,18 +24,6 @@ namespace ImmersedGrains
       return p;
     }
 
-    template <int dim>
-    std::array<bool, 2 * dim>
-    wall_faces(const Geometry<dim> &geometry)
-    {
-      // Open faces let grains leave, periodic ones wrap them: no walls.
-      std::array<bool, 2 * dim> w;
-      for (unsigned int f = 0; f < 2 * dim; ++f)
-        w[f] = geometry.boundary_types[f] != BoundaryType::open &&
-               geometry.boundary_types[f] != BoundaryType::periodic;
-      return w;
-    }
-
     /** Distance from @p y to the interval of @p box along axis @p d. */
     template <int dim>
     double
@@ -76,9 +64,7 @@ namespace ImmersedGrains
              periodic_axes(geometry))
       , solver(parameters)
   {
-    walls.add_box(geometry.lower_corner,
-                  geometry.upper_corner,
-                  wall_faces(geometry));
+    geometry.add_walls(walls);
   }
 
 

@@ -1,4 +1,5 @@
 #include <deal.II/base/utilities.h>
+#include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/filtered_iterator.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/numerics/rtree.h>
@@ -77,6 +78,12 @@ namespace ImmersedGrains
       , timer(timer)
       , properties(
           make_grain_property_layout(parameters, with_fluid, straight_paths))
+      , mapping_owner(geometry.is_cartesian() ?
+                        std::unique_ptr<dealii::Mapping<dim>>(
+                          std::make_unique<dealii::MappingCartesian<dim>>()) :
+                        std::unique_ptr<dealii::Mapping<dim>>(
+                          std::make_unique<dealii::MappingQ1<dim>>()))
+      , mapping(*mapping_owner)
       , particles(tria, mapping, properties.n_properties)
       , vertex_cache(tria, mapping)
   {
@@ -823,7 +830,7 @@ namespace ImmersedGrains
         largest[1] = std::max(largest[1], (c.velocity[i] - v0).norm());
       }
       bool left = false;
-      for (unsigned int d = 0; d < dim && !fixed; ++d)
+      for (unsigned int d = 0; d < dim && !fixed && geometry.is_box(); ++d)
       {
         const double L = hi[d] - lo[d];
         if (geometry.is_periodic(d))
@@ -836,7 +843,7 @@ namespace ImmersedGrains
           const bool beyond = side == 0 ? x[d] < lo[d] : x[d] > hi[d];
           if (!beyond)
             continue;
-          if (geometry.boundary_types[2 * d + side] == BoundaryType::open)
+          if (geometry.boundary_type(2 * d + side) == BoundaryType::open)
             left = true;
           else
             // The centre went through a wall (a grain overlapping it by
@@ -859,6 +866,13 @@ namespace ImmersedGrains
         in_cell = dealii::GeometryInfo<dim>::is_inside_unit_cell(reference);
         if (in_cell)
           p->set_reference_location(reference);
+        // A mesh's open boundary: a centre outside the domain has left.
+        else if (!geometry.is_box() && geometry.has_open_boundary() &&
+                 !geometry.contains(x))
+        {
+          leaving.push_back(p);
+          continue;
+        }
       }
       auto props = p->get_properties();
       for (unsigned int d = 0; d < dim; ++d)

@@ -524,6 +524,30 @@ namespace ImmersedGrains
     {
       const auto &lo = geometry.lower_corner;
       const auto &hi = geometry.upper_corner;
+      if (!geometry.is_box())
+      {
+        // Inside the mesh, and clear of the walls it meets.
+        Contact::Walls<dim> walls;
+        geometry.add_walls(walls);
+        for (unsigned int k = 0; k < grains.size(); ++k)
+        {
+          const auto &g    = grains[k];
+          const auto  name = "grain " + std::to_string(k + 1) + " at " +
+                            to_text(g.position) + " with radius " +
+                            std::to_string(g.radius);
+          if (!geometry.contains(g.position))
+            where.fail(parameter,
+                       value,
+                       name + " is outside the mesh " + geometry.mesh_file);
+          const double clearance = walls.clearance(g.position, g.radius, 0);
+          if (clearance < -1e-9 * g.radius)
+            where.fail(parameter,
+                       value,
+                       name + " overlaps a wall of the mesh by " +
+                         std::to_string(-clearance) + " m");
+        }
+        return;
+      }
       for (unsigned int k = 0; k < grains.size(); ++k)
         for (unsigned int d = 0; d < dim; ++d)
         {

@@ -288,6 +288,15 @@ namespace ImmersedGrains
       , triangulation(tria)
       , smallest_cell(smallest_cell)
   {
+    if (!geometry.is_box())
+    {
+      for (const auto &cell : triangulation.cell_iterators_on_level(0))
+      {
+        coarse.push_back(cell);
+        coarse_boxes.push_back(cell->bounding_box());
+      }
+      return;
+    }
     // The coarse mesh is the box's Subdivisions (Geometry), whatever the
     // order in which the triangulation holds its coarse cells.
     unsigned int n = 1;
@@ -318,6 +327,8 @@ namespace ImmersedGrains
   typename dealii::Triangulation<dim>::active_cell_iterator
   Adaptivity<dim>::active_cell_at(dealii::Point<dim> point) const
   {
+    if (!geometry.is_box())
+      return mesh_cell_at(point);
     const auto  &lo = geometry.lower_corner;
     const auto  &hi = geometry.upper_corner;
     unsigned int k = 0, stride = 1;
@@ -347,6 +358,35 @@ namespace ImmersedGrains
       cell = cell->child(child);
     }
     return typename dealii::Triangulation<dim>::active_cell_iterator(cell);
+  }
+
+
+  template <int dim>
+  typename dealii::Triangulation<dim>::active_cell_iterator
+  Adaptivity<dim>::mesh_cell_at(const dealii::Point<dim> &point) const
+  {
+    // The coarse cells whose boxes hold the point, then down the tree of
+    // the one that holds it. Axis-parallel cells are their boxes.
+    const bool cartesian = geometry.is_cartesian();
+    const auto inside    = [&](const auto &cell)
+    {
+      return cartesian ? cell->bounding_box().point_inside(point) :
+                         cell->point_inside(point);
+    };
+    for (unsigned int k = 0; k < coarse.size(); ++k)
+      if (coarse_boxes[k].point_inside(point) && inside(coarse[k]))
+      {
+        typename dealii::Triangulation<dim>::cell_iterator cell = coarse[k];
+        while (cell->has_children())
+        {
+          unsigned int c = 0;
+          while (c + 1 < cell->n_children() && !inside(cell->child(c)))
+            ++c;
+          cell = cell->child(c);
+        }
+        return typename dealii::Triangulation<dim>::active_cell_iterator(cell);
+      }
+    return triangulation.end();
   }
 
 

@@ -1,12 +1,20 @@
 #include <deal.II/base/utilities.h>
+#include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/grid_tools_cache.h>
 
 #include <immersed_grains/mesh/geometry.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <optional>
+#include <set>
+#include <sstream>
 
 namespace ImmersedGrains
 {
@@ -38,6 +46,19 @@ namespace ImmersedGrains
     using dealii::Patterns::Integer;
     prm.enter_subsection("Mesh");
     {
+      prm.declare_entry(
+        "Geometry",
+        "box",
+        dealii::Patterns::Selection("box|gmsh"),
+        "box: the box of Lower corner, Upper corner and Subdivisions; gmsh: "
+        "the mesh of File (Gmsh .msh, format 2.2 or 4.1 ASCII, "
+        "quadrilaterals in 2D, hexahedra in 3D, physical group ids as "
+        "boundary ids).");
+      prm.declare_entry("File",
+                        "",
+                        Anything(),
+                        "The Gmsh mesh of Geometry = gmsh; a relative path is "
+                        "read from the folder of the parameter file.");
       prm.declare_entry("Lower corner",
                         dim == 2 ? "0, 0" : "0, 0, 0",
                         Anything(),
@@ -60,10 +81,14 @@ namespace ImmersedGrains
         dim == 2 ? "wall, wall, wall, wall" :
                    "wall, wall, wall, wall, wall, wall",
         Anything(),
-        "One entry per face in the order x-min, x-max, y-min, y-max[, z-min, "
-        "z-max] (boundary ids 0..2dim-1): wall (no-slip), slip (no normal "
-        "flow), open (traction-free, Fluid/Open boundary pressure), velocity "
-        "(Fluid/Boundary velocity) or periodic (both faces of a direction).");
+        "A box: one entry per face in the order x-min, x-max, y-min, "
+        "y-max[, z-min, z-max] (boundary ids 0..2dim-1). A Gmsh mesh: "
+        "'id: type' pairs separated by commas, one for every boundary id "
+        "of the mesh (e.g. '1: inflow, 2: open, 3: wall'). Types: wall "
+        "(no-slip), slip (no normal flow), open (traction-free, "
+        "Fluid/Open boundary pressure; grains leave), inflow or velocity "
+        "(Fluid/Inflow velocity; grains meet it as a wall) or periodic "
+        "(both faces of a box's direction).");
     }
     prm.leave_subsection();
   }
@@ -77,71 +102,355 @@ namespace ImmersedGrains
     const InputLocation where{file, "Mesh"};
     prm.enter_subsection("Mesh");
     {
-      lower_corner =
-        parse_point<dim>(prm.get("Lower corner"), where, "Lower corner");
-      upper_corner =
-        parse_point<dim>(prm.get("Upper corner"), where, "Upper corner");
-      for (unsigned int d = 0; d < dim; ++d)
-        where.require(upper_corner[d] > lower_corner[d],
-                      "Upper corner",
-                      prm.get("Upper corner"),
-                      "must be above Lower corner (" + prm.get("Lower corner") +
-                        ") in every coordinate");
+      box                       = prm.get("Geometry") == "box";
+      initial_refinement        = prm.get_integer("Initial refinement");
+      const std::string bc_text = prm.get("Boundary conditions");
+      if (box)
+      {
+        parse_box(prm, where);
+        parse_box_conditions(where, bc_text);
+      }
+      else
+      {
+        where.require(!prm.get("File").empty(),
+                      "File",
+                      "",
+                      "Geometry = gmsh needs the mesh's file");
+        std::filesystem::path path(prm.get("File"));
+        if (path.is_relative())
+          path = std::filesystem::path(file).parent_path() / path;
+        mesh_file = path.lexically_normal().string();
+        read_mesh(where, prm.get("File"));
+        parse_mesh_conditions(where, bc_text);
+      }
+    }
+    prm.leave_subsection();
+  }
 
-      const auto n =
-        parse_double_list(prm.get("Subdivisions"), where, "Subdivisions");
-      where.require(n.size() == 1 || n.size() == dim,
+
+  template <int dim>
+  void
+  Geometry<dim>::parse_box(dealii::ParameterHandler &prm,
+                           const InputLocation      &where)
+  {
+    lower_corner =
+      parse_point<dim>(prm.get("Lower corner"), where, "Lower corner");
+    upper_corner =
+      parse_point<dim>(prm.get("Upper corner"), where, "Upper corner");
+    for (unsigned int d = 0; d < dim; ++d)
+      where.require(upper_corner[d] > lower_corner[d],
+                    "Upper corner",
+                    prm.get("Upper corner"),
+                    "must be above Lower corner (" + prm.get("Lower corner") +
+                      ") in every coordinate");
+
+    const auto n =
+      parse_double_list(prm.get("Subdivisions"), where, "Subdivisions");
+    where.require(n.size() == 1 || n.size() == dim,
+                  "Subdivisions",
+                  prm.get("Subdivisions"),
+                  "give one number or one per direction");
+    subdivisions.clear();
+    domain_volume = 1;
+    coarse_edge   = std::numeric_limits<double>::max();
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      const double v = n.size() == 1 ? n[0] : n[d];
+      where.require(v >= 1 && v == std::floor(v) && v < 1e6,
                     "Subdivisions",
                     prm.get("Subdivisions"),
-                    "give one number or one per direction");
-      subdivisions.clear();
-      for (unsigned int d = 0; d < dim; ++d)
-      {
-        const double v = n.size() == 1 ? n[0] : n[d];
-        where.require(v >= 1 && v == std::floor(v) && v < 1e6,
-                      "Subdivisions",
-                      prm.get("Subdivisions"),
-                      "must be positive integers");
-        subdivisions.push_back(static_cast<unsigned int>(v));
-      }
-      initial_refinement = prm.get_integer("Initial refinement");
+                    "must be positive integers");
+      subdivisions.push_back(static_cast<unsigned int>(v));
+      domain_volume *= upper_corner[d] - lower_corner[d];
+      coarse_edge =
+        std::min(coarse_edge, (upper_corner[d] - lower_corner[d]) / v);
+    }
+    cartesian = true;
+  }
 
-      const std::string bc_text = prm.get("Boundary conditions");
-      const auto        entries = dealii::Utilities::split_string_list(bc_text);
+
+  namespace
+  {
+    std::optional<BoundaryType>
+    boundary_type_named(const std::string &name)
+    {
+      if (name == "wall")
+        return BoundaryType::wall;
+      if (name == "slip")
+        return BoundaryType::slip;
+      if (name == "open")
+        return BoundaryType::open;
+      if (name == "velocity" || name == "inflow")
+        return BoundaryType::velocity;
+      if (name == "periodic")
+        return BoundaryType::periodic;
+      return std::nullopt;
+    }
+
+    const char *const type_names = "wall, slip, open, inflow, periodic";
+
+    std::string
+    id_list(const std::set<unsigned int> &ids)
+    {
+      std::string text;
+      for (const unsigned int id : ids)
+        text += (text.empty() ? "" : ", ") + std::to_string(id);
+      return text;
+    }
+  } // namespace
+
+
+  template <int dim>
+  void
+  Geometry<dim>::parse_box_conditions(const InputLocation &where,
+                                      const std::string   &bc_text)
+  {
+    const auto entries = dealii::Utilities::split_string_list(bc_text);
+    boundary_types.clear();
+    if (bc_text.find(':') != std::string::npos)
+      parse_id_conditions(where, bc_text);
+    else
+    {
       where.require(entries.size() == 2 * dim,
                     "Boundary conditions",
                     bc_text,
                     "expected " + std::to_string(2 * dim) +
                       " entries, one per face, got " +
                       std::to_string(entries.size()));
-      boundary_types.clear();
-      for (const std::string &e : entries)
+      for (unsigned int f = 0; f < entries.size(); ++f)
       {
-        if (e == "wall")
-          boundary_types.push_back(BoundaryType::wall);
-        else if (e == "slip")
-          boundary_types.push_back(BoundaryType::slip);
-        else if (e == "open")
-          boundary_types.push_back(BoundaryType::open);
-        else if (e == "velocity")
-          boundary_types.push_back(BoundaryType::velocity);
-        else if (e == "periodic")
-          boundary_types.push_back(BoundaryType::periodic);
-        else
+        const auto type = boundary_type_named(entries[f]);
+        if (!type)
           where.fail("Boundary conditions",
                      bc_text,
-                     "unknown type '" + e +
-                       "' (wall, slip, open, velocity, periodic)");
+                     "unknown type '" + entries[f] + "' (" + type_names + ")");
+        boundary_types[f] = *type;
       }
-      for (unsigned int d = 0; d < dim; ++d)
-        where.require((boundary_types[2 * d] == BoundaryType::periodic) ==
-                        (boundary_types[2 * d + 1] == BoundaryType::periodic),
-                      "Boundary conditions",
-                      bc_text,
-                      "periodic faces come in pairs (both faces of a "
-                      "direction)");
     }
-    prm.leave_subsection();
+    std::set<unsigned int> named;
+    for (const auto &[id, type] : boundary_types)
+      named.insert(id);
+    std::set<unsigned int> faces;
+    for (unsigned int f = 0; f < 2 * dim; ++f)
+      faces.insert(f);
+    where.require(named == faces,
+                  "Boundary conditions",
+                  bc_text,
+                  "a box's boundary ids are " + id_list(faces) +
+                    ", one per face");
+    for (unsigned int d = 0; d < dim; ++d)
+      where.require((boundary_types[2 * d] == BoundaryType::periodic) ==
+                      (boundary_types[2 * d + 1] == BoundaryType::periodic),
+                    "Boundary conditions",
+                    bc_text,
+                    "periodic faces come in pairs (both faces of a "
+                    "direction)");
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::parse_id_conditions(const InputLocation &where,
+                                     const std::string   &bc_text)
+  {
+    for (const std::string &entry :
+         dealii::Utilities::split_string_list(bc_text, ','))
+    {
+      const auto   pair = dealii::Utilities::split_string_list(entry, ':');
+      unsigned int id   = 0;
+      bool         ok   = pair.size() == 2 && !pair[0].empty() &&
+                pair[0].find_first_not_of("0123456789") == std::string::npos &&
+                pair[0].size() < 6;
+      if (ok)
+        id = std::stoi(pair[0]);
+      if (!ok || id >= dealii::numbers::internal_face_boundary_id)
+        where.fail("Boundary conditions",
+                   bc_text,
+                   "'" + entry + "' is not 'id: type' with id a boundary id");
+      const auto type = boundary_type_named(pair[1]);
+      if (!type)
+        where.fail("Boundary conditions",
+                   bc_text,
+                   "unknown type '" + pair[1] + "' (" + type_names + ")");
+      where.require(boundary_types.count(id) == 0,
+                    "Boundary conditions",
+                    bc_text,
+                    "boundary id " + std::to_string(id) + " is named twice");
+      boundary_types[id] = *type;
+    }
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::parse_mesh_conditions(const InputLocation &where,
+                                       const std::string   &bc_text)
+  {
+    std::set<unsigned int> on_mesh;
+    for (const auto &cell : coarse_mesh->active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->at_boundary(f))
+          on_mesh.insert(cell->face(f)->boundary_id());
+    where.require(bc_text.find(':') != std::string::npos,
+                  "Boundary conditions",
+                  bc_text,
+                  "a Gmsh mesh needs 'id: type' pairs for its boundary ids " +
+                    id_list(on_mesh));
+    boundary_types.clear();
+    parse_id_conditions(where, bc_text);
+    for (const unsigned int id : on_mesh)
+      where.require(
+        boundary_types.count(id) == 1,
+        "Boundary conditions",
+        bc_text,
+        "boundary id " + std::to_string(id) + " of " + mesh_file +
+          " has no type (the mesh's boundary ids: " + id_list(on_mesh) +
+          (id == 0 ? "; 0 is a boundary in no physical group" : "") + ")");
+    for (const auto &[id, type] : boundary_types)
+    {
+      where.require(on_mesh.count(id) == 1,
+                    "Boundary conditions",
+                    bc_text,
+                    "boundary id " + std::to_string(id) + " is not on " +
+                      mesh_file + "'s boundary (its ids: " + id_list(on_mesh) +
+                      ")");
+      where.require(type != BoundaryType::periodic,
+                    "Boundary conditions",
+                    bc_text,
+                    "periodic boundaries need Geometry = box");
+    }
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::read_mesh(const InputLocation &where, const std::string &text)
+  {
+    std::ifstream in(mesh_file);
+    where.require(static_cast<bool>(in),
+                  "File",
+                  text,
+                  "cannot be read (" + mesh_file + ")");
+    auto read = std::make_shared<dealii::Triangulation<dim>>();
+    try
+    {
+      dealii::GridIn<dim> grid_in;
+      grid_in.attach_triangulation(*read);
+      grid_in.read_msh(in);
+    }
+    catch (const std::exception &e)
+    {
+      std::string message = one_line(e.what());
+      // deal.II's messages open with where in its sources the check
+      // failed; the reason follows "Additional information:".
+      const auto info = message.find("Additional information:");
+      if (info != std::string::npos)
+        message = message.substr(info + 23);
+      // and closes with a rule of dashes.
+      const auto rule = message.find("---");
+      if (rule != std::string::npos)
+        message = message.substr(0, rule);
+      while (!message.empty() && (message.back() == ' ' || message[0] == ' '))
+        message = message.back() == ' ' ?
+                    message.substr(0, message.size() - 1) :
+                    message.substr(1);
+      if (message.size() > 200)
+        message = message.substr(0, 200) + " ...";
+      where.fail("File", text, "is not a mesh deal.II reads: " + message);
+    }
+    where.require(read->n_active_cells() > 0,
+                  "File",
+                  text,
+                  "has no " +
+                    std::string(dim == 2 ? "quadrilaterals" : "hexahedra") +
+                    " (a mesh needs a Physical " +
+                    (dim == 2 ? "Surface" : "Volume") +
+                    " for its cells to be saved)");
+    for (const auto &cell : read->active_cell_iterators())
+      where.require(cell->reference_cell() ==
+                      dealii::ReferenceCells::get_hypercube<dim>(),
+                    "File",
+                    text,
+                    std::string("has ") +
+                      (dim == 2 ? "triangles" :
+                                  "tetrahedra, prisms or "
+                                  "pyramids") +
+                      "; only " + (dim == 2 ? "quadrilaterals" : "hexahedra") +
+                      " are supported (Gmsh: Mesh.RecombineAll = 1" +
+                      (dim == 3 ?
+                         " and Mesh.SubdivisionAlgorithm = 2, or a transfinite "
+                         "mesh" :
+                         "") +
+                      ")");
+
+    // Axis-parallel cells are renumbered lexicographically (vertex 0 the
+    // lowest corner), which MappingCartesian needs; the same numbering on
+    // every cell keeps the faces consistently oriented.
+    cartesian = true;
+    std::vector<dealii::CellData<dim>> cells;
+    for (const auto &cell : read->active_cell_iterators())
+    {
+      const auto box                  = cell->bounding_box();
+      const auto &[lo, hi]            = box.get_boundary_points();
+      const double          tolerance = 1e-10 * lo.distance(hi);
+      dealii::CellData<dim> data;
+      data.material_id = cell->material_id();
+      std::vector<bool> found(cell->n_vertices(), false);
+      for (const unsigned int v : cell->vertex_indices())
+      {
+        unsigned int corner    = 0;
+        bool         at_corner = true;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          const double x = cell->vertex(v)[d];
+          if (std::abs(x - hi[d]) <= tolerance)
+            corner |= 1u << d;
+          else if (std::abs(x - lo[d]) > tolerance)
+            at_corner = false;
+        }
+        if (!at_corner || found[corner] || hi[0] - lo[0] <= tolerance)
+        {
+          cartesian = false;
+          break;
+        }
+        found[corner]         = true;
+        data.vertices[corner] = cell->vertex_index(v);
+      }
+      if (!cartesian)
+        break;
+      cells.push_back(data);
+    }
+    if (cartesian)
+    {
+      dealii::SubCellData boundary;
+      for (const auto &cell : read->active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f))
+          {
+            dealii::CellData<dim - 1> face;
+            for (const unsigned int v : cell->face(f)->vertex_indices())
+              face.vertices[v] = cell->face(f)->vertex_index(v);
+            face.boundary_id = cell->face(f)->boundary_id();
+            if constexpr (dim == 2)
+              boundary.boundary_lines.push_back(face);
+            else
+              boundary.boundary_quads.push_back(face);
+          }
+      coarse_mesh = std::make_shared<dealii::Triangulation<dim>>();
+      coarse_mesh->create_triangulation(read->get_vertices(), cells, boundary);
+    }
+    else
+      coarse_mesh = read;
+
+    const auto bounds = dealii::GridTools::compute_bounding_box(*coarse_mesh)
+                          .get_boundary_points();
+    lower_corner  = bounds.first;
+    upper_corner  = bounds.second;
+    domain_volume = dealii::GridTools::volume(*coarse_mesh);
+    coarse_edge   = std::numeric_limits<double>::max();
+    for (const auto &cell : coarse_mesh->active_cell_iterators())
+      coarse_edge = std::min(coarse_edge, cell->minimum_vertex_distance());
+    subdivisions.clear();
   }
 
 
@@ -149,7 +458,188 @@ namespace ImmersedGrains
   bool
   Geometry<dim>::is_periodic(const unsigned int direction) const
   {
-    return boundary_types[2 * direction] == BoundaryType::periodic;
+    return box && boundary_types.at(2 * direction) == BoundaryType::periodic;
+  }
+
+
+  template <int dim>
+  bool
+  Geometry<dim>::is_box() const
+  {
+    return box;
+  }
+
+
+  template <int dim>
+  bool
+  Geometry<dim>::is_cartesian() const
+  {
+    return cartesian;
+  }
+
+
+  template <int dim>
+  BoundaryType
+  Geometry<dim>::boundary_type(const dealii::types::boundary_id id) const
+  {
+    const auto entry = boundary_types.find(id);
+    AssertThrow(entry != boundary_types.end(),
+                dealii::ExcMessage("boundary id " + std::to_string(id) +
+                                   " has no boundary condition"));
+    return entry->second;
+  }
+
+
+  template <int dim>
+  std::vector<dealii::types::boundary_id>
+  Geometry<dim>::boundary_ids(const BoundaryType type) const
+  {
+    std::vector<dealii::types::boundary_id> ids;
+    for (const auto &[id, t] : boundary_types)
+      if (t == type)
+        ids.push_back(id);
+    return ids;
+  }
+
+
+  template <int dim>
+  bool
+  Geometry<dim>::has_velocity_boundary() const
+  {
+    return !boundary_ids(BoundaryType::velocity).empty();
+  }
+
+
+  template <int dim>
+  double
+  Geometry<dim>::volume() const
+  {
+    return domain_volume;
+  }
+
+
+  template <int dim>
+  std::vector<unsigned int>
+  Geometry<dim>::equivalent_subdivisions() const
+  {
+    if (box)
+      return subdivisions;
+    const double h = std::pow(domain_volume / n_coarse_cells(), 1.0 / dim);
+    std::vector<unsigned int> n(dim);
+    for (unsigned int d = 0; d < dim; ++d)
+      n[d] = std::max(1u,
+                      static_cast<unsigned int>(
+                        std::round((upper_corner[d] - lower_corner[d]) / h)));
+    return n;
+  }
+
+
+  template <int dim>
+  unsigned int
+  Geometry<dim>::n_coarse_cells() const
+  {
+    if (!box)
+      return coarse_mesh->n_active_cells();
+    unsigned int n = 1;
+    for (const unsigned int s : subdivisions)
+      n *= s;
+    return n;
+  }
+
+
+  template <int dim>
+  bool
+  Geometry<dim>::contains(const dealii::Point<dim> &x) const
+  {
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      const double eps = 1e-12 * (upper_corner[d] - lower_corner[d]);
+      if (x[d] < lower_corner[d] - eps || x[d] > upper_corner[d] + eps)
+        return false;
+    }
+    if (box)
+      return true;
+    if (!locator)
+      locator = std::make_shared<dealii::GridTools::Cache<dim>>(
+        *coarse_mesh, dealii::StaticMappingQ1<dim>::mapping);
+    const auto found = dealii::GridTools::find_active_cell_around_point(
+      *locator,
+      x,
+      typename dealii::Triangulation<dim>::active_cell_iterator(),
+      std::vector<bool>(),
+      1e-10);
+    return found.first.state() == dealii::IteratorState::valid;
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::add_walls(Contact::Walls<dim> &walls) const
+  {
+    const auto meets = [](const BoundaryType t)
+    { return t != BoundaryType::open && t != BoundaryType::periodic; };
+    if (box)
+    {
+      std::array<bool, 2 * dim> is_wall;
+      for (unsigned int f = 0; f < 2 * dim; ++f)
+        is_wall[f] = meets(boundary_types.at(f));
+      walls.add_box(lower_corner, upper_corner, is_wall);
+      return;
+    }
+    std::map<unsigned int, unsigned int>     number; // mesh vertex -> wall's
+    std::vector<dealii::Point<dim>>          points;
+    std::vector<Contact::BoundaryFacet<dim>> facets;
+    const auto vertex = [&](const auto &face, const unsigned int v)
+    {
+      const auto [entry, added] =
+        number.emplace(face->vertex_index(v), points.size());
+      if (added)
+        points.push_back(face->vertex(v));
+      return entry->second;
+    };
+    for (const auto &cell : coarse_mesh->active_cell_iterators())
+      for (const unsigned int f : cell->face_indices())
+        if (cell->at_boundary(f) &&
+            meets(boundary_types.at(cell->face(f)->boundary_id())))
+        {
+          const auto                face = cell->face(f);
+          std::vector<unsigned int> corners;
+          for (const unsigned int v : face->vertex_indices())
+            corners.push_back(vertex(face, v));
+          // A quadrilateral's corners in deal.II's numbering go round as
+          // 0, 1, 3, 2: two triangles sharing the diagonal 0-3.
+          std::vector<std::array<unsigned int, dim>>   pieces;
+          const std::vector<std::vector<unsigned int>> corner_sets =
+            dim == 2 ?
+              std::vector<std::vector<unsigned int>>{{0, 1}} :
+              std::vector<std::vector<unsigned int>>{{0, 1, 3}, {0, 3, 2}};
+          for (const auto &set : corner_sets)
+          {
+            std::array<unsigned int, dim> piece;
+            for (unsigned int a = 0; a < dim; ++a)
+              piece[a] = corners[set[a]];
+            pieces.push_back(piece);
+          }
+          for (const auto &piece : pieces)
+          {
+            dealii::Tensor<1, dim> normal;
+            const auto             e = points[piece[1]] - points[piece[0]];
+            if (dim == 2)
+            {
+              normal[0] = -e[1];
+              normal[1] = e[0];
+            }
+            else
+              normal = dealii::cross_product_3d(e,
+                                                points[piece[dim - 1]] -
+                                                  points[piece[0]]);
+            if (normal * (cell->center() - points[piece[0]]) < 0)
+              normal = -normal;
+            facets.push_back({piece, normal});
+          }
+        }
+    if (!facets.empty())
+      walls.add_facets(points, facets);
   }
 
 
@@ -169,10 +659,7 @@ namespace ImmersedGrains
   bool
   Geometry<dim>::has_open_boundary() const
   {
-    for (const auto t : boundary_types)
-      if (t == BoundaryType::open)
-        return true;
-    return false;
+    return !boundary_ids(BoundaryType::open).empty();
   }
 
 
@@ -202,10 +689,12 @@ namespace ImmersedGrains
   double
   Geometry<dim>::wall_gap() const
   {
+    if (!box)
+      return shortest_side();
     const auto no_slip = [&](const unsigned int face)
     {
-      return boundary_types[face] == BoundaryType::wall ||
-             boundary_types[face] == BoundaryType::velocity;
+      return boundary_types.at(face) == BoundaryType::wall ||
+             boundary_types.at(face) == BoundaryType::velocity;
     };
     double gap = std::numeric_limits<double>::max();
     for (unsigned int d = 0; d < dim; ++d)
@@ -225,12 +714,7 @@ namespace ImmersedGrains
   double
   Geometry<dim>::shortest_cell_edge(const unsigned int level) const
   {
-    double h = std::numeric_limits<double>::max();
-    for (unsigned int d = 0; d < dim; ++d)
-      h = std::min(h,
-                   (upper_corner[d] - lower_corner[d]) / subdivisions[d] /
-                     std::pow(2.0, level));
-    return h;
+    return coarse_edge / std::pow(2.0, level);
   }
 
 
@@ -249,6 +733,11 @@ namespace ImmersedGrains
   Geometry<dim>::create_coarse_mesh(
     dealii::parallel::distributed::Triangulation<dim> &tria) const
   {
+    if (!box)
+    {
+      tria.copy_triangulation(*coarse_mesh);
+      return;
+    }
     dealii::GridGenerator::subdivided_hyper_rectangle(
       tria, subdivisions, lower_corner, upper_corner, /*colorize=*/true);
 

@@ -59,8 +59,8 @@ namespace ImmersedGrains
     double velocity_nodes = 1, pressure_nodes = 1, cells = 1;
     for (unsigned int d = 0; d < dim; ++d)
     {
-      const double n =
-        geometry.subdivisions[d] * std::pow(2.0, geometry.initial_refinement);
+      const double n = geometry.equivalent_subdivisions()[d] *
+                       std::pow(2.0, geometry.initial_refinement);
       cells *= n;
       velocity_nodes *= 2 * n + 1;
       pressure_nodes *= n + 1;
@@ -114,7 +114,7 @@ namespace ImmersedGrains
     bool                       all   = true; // every cell of the level
     std::vector<std::uint64_t> refined;      // else: these
     for (unsigned int d = 0; d < dim; ++d)
-      cells *= geometry.subdivisions[d];
+      cells *= geometry.equivalent_subdivisions()[d];
     // Below Min level every cell is refined, whatever the floor.
     const unsigned int top =
       std::max(finest, std::min(band.min_level, band.max_level));
@@ -124,7 +124,8 @@ namespace ImmersedGrains
       double                        level_cells = 1;
       for (unsigned int d = 0; d < dim; ++d)
       {
-        n[d] = static_cast<std::int64_t>(geometry.subdivisions[d]) << level;
+        n[d] = static_cast<std::int64_t>(geometry.equivalent_subdivisions()[d])
+               << level;
         level_cells *= n[d];
       }
       // Beyond the keys' range the band alone is far beyond any memory:

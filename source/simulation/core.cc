@@ -247,14 +247,10 @@ namespace ImmersedGrains
 
     geometry.parse_parameters(prm, file);
     for (const auto &point : pressure_drop_points)
-      for (unsigned int d = 0; d < dim; ++d)
-        InputLocation{file, "Output"}.require(point[d] >=
-                                                  geometry.lower_corner[d] &&
-                                                point[d] <=
-                                                  geometry.upper_corner[d],
-                                              "Pressure drop points",
-                                              pressure_drop_text,
-                                              "a point lies outside the mesh");
+      InputLocation{file, "Output"}.require(geometry.contains(point),
+                                            "Pressure drop points",
+                                            pressure_drop_text,
+                                            "a point lies outside the mesh");
     fluid_parameters.parse_parameters(prm, file, geometry);
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
@@ -425,8 +421,11 @@ namespace ImmersedGrains
       pcout << "  resumed from " << resume_from << '\n';
     pcout << "  mesh: " << triangulation.n_global_active_cells()
           << " cells, boundary conditions:";
-    for (const auto t : geometry.boundary_types)
-      pcout << ' ' << to_string(t);
+    if (!geometry.is_box())
+      pcout << " (" << geometry.mesh_file << ")";
+    for (const auto &[id, type] : geometry.boundary_types)
+      pcout << (geometry.is_box() ? " " : " " + std::to_string(id) + ": ")
+            << to_string(type);
     pcout << '\n';
     pcout << "  estimate: " << size_estimate.cells << " cells, "
           << size_estimate.dofs << " DoFs, peak memory about "

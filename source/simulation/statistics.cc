@@ -152,9 +152,7 @@ namespace ImmersedGrains
   void
   Simulation<dim>::set_fluid_statistics()
   {
-    double volume = 1;
-    for (unsigned int d = 0; d < dim; ++d)
-      volume *= geometry.upper_corner[d] - geometry.lower_corner[d];
+    const double volume = geometry.volume();
     // The coupling knows its fluid fraction node by node; prescribed
     // fields are integrated by quadrature.
     const double fluid_volume = coupling && coupling_parameters.two_way ?

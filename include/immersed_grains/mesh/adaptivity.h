@@ -169,8 +169,14 @@ namespace ImmersedGrains
     dealii::parallel::distributed::Triangulation<dim> &triangulation;
     const double                                       smallest_cell;
     double                                             horizon = 0;
-    /// The coarse cells (level 0) in the box's lexicographic order.
+    /** active_cell_at() on a Gmsh mesh. */
+    typename dealii::Triangulation<dim>::active_cell_iterator
+    mesh_cell_at(const dealii::Point<dim> &point) const;
+
+    /// The coarse cells (level 0) in the box's lexicographic order; for a
+    /// Gmsh mesh in the triangulation's order, with their bounding boxes.
     std::vector<typename dealii::Triangulation<dim>::cell_iterator> coarse;
+    std::vector<dealii::BoundingBox<dim>> coarse_boxes;
   };
 } // namespace ImmersedGrains
 

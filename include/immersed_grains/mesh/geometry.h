@@ -5,20 +5,33 @@
 #include <deal.II/base/point.h>
 #include <deal.II/distributed/tria.h>
 
+#include <immersed_grains/contact/walls.h>
 #include <immersed_grains/parameters.h>
 
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
+namespace dealii
+{
+  namespace GridTools
+  {
+    template <int dim, int spacedim>
+    class Cache;
+  }
+} // namespace dealii
+
 namespace ImmersedGrains
 {
-  /** What happens to fluid and grains at one face of the box. */
+  /** What happens to fluid and grains at one part of the boundary. */
   enum class BoundaryType
   {
     wall,     // no-slip for the fluid, a wall for grains
     slip,     // no normal flow, free tangential flow; a wall for grains
     open,     // traction (prescribed pressure) for the fluid; grains leave
-    velocity, // prescribed fluid velocity (Fluid/Boundary velocity); a wall
+    velocity, // prescribed fluid velocity (Fluid/Inflow velocity); a wall
+              // for grains, as a distributor plate is ('inflow' in a file)
     periodic  // paired with the opposite face
   };
 
@@ -26,9 +39,13 @@ namespace ImmersedGrains
   to_string(BoundaryType type);
 
   /**
-   * The box domain, its subdivisions and the boundary condition of each
-   * face. Boundary id i is face i in deal.II's numbering: 0 = x-min,
-   * 1 = x-max, 2 = y-min, 3 = y-max, 4 = z-min, 5 = z-max.
+   * The domain: a box (`Geometry = box`: `Lower corner`, `Upper corner`,
+   * `Subdivisions`; boundary id i is face i in deal.II's numbering,
+   * 0 = x-min, 1 = x-max, 2 = y-min, 3 = y-max, 4 = z-min, 5 = z-max) or a
+   * mesh read from a Gmsh file (`Geometry = gmsh`: quadrilaterals in 2D,
+   * hexahedra in 3D, physical group ids as boundary ids). Either way it
+   * gives the boundary condition of each boundary id, the coarse mesh, the
+   * walls grains meet, and the sizes the solvers are tuned by.
    */
   template <int dim>
   class Geometry
@@ -50,6 +67,15 @@ namespace ImmersedGrains
     void
     create_mesh(dealii::parallel::distributed::Triangulation<dim> &tria) const;
 
+    /** Whether the domain is a box (`Geometry = box`). */
+    bool
+    is_box() const;
+
+    /** Whether every coarse cell is an axis-parallel box (always for a
+     *  box domain), so that MappingCartesian is exact on every cell. */
+    bool
+    is_cartesian() const;
+
     bool
     is_periodic(unsigned int direction) const;
 
@@ -61,32 +87,97 @@ namespace ImmersedGrains
     bool
     has_open_boundary() const;
 
-    /** The shortest and the longest side of the box. */
+    /** Whether some boundary carries a prescribed velocity. */
+    bool
+    has_velocity_boundary() const;
+
+    /** The boundary ids of a type. */
+    std::vector<dealii::types::boundary_id>
+    boundary_ids(BoundaryType type) const;
+
+    /** The type of boundary id @p id. */
+    BoundaryType
+    boundary_type(dealii::types::boundary_id id) const;
+
+    /** The shortest and the longest side of the domain's bounding box. */
     double
     shortest_side() const;
     double
     longest_side() const;
+
+    /** The domain's volume (area in 2D). */
+    double
+    volume() const;
 
     /** The width of the gap between the no-slip faces (wall, velocity)
      *  that confine the flow: per direction the side where both faces are
      *  no-slip, twice it where one is (the other slip or open: a film,
      *  half of a channel), nothing where neither is (periodic, slip,
      *  open); the narrowest of these, or the shortest side where no face
-     *  is no-slip. The fluid preconditioner's Darcy floor is of the order
-     *  of mu over its square (fluid_assembly.cc). */
+     *  is no-slip. A Gmsh domain: the shortest side of its bounding box.
+     *  The fluid preconditioner's Darcy floor is of the order of mu over
+     *  its square (fluid_assembly.cc). */
     double
     wall_gap() const;
 
     /** The shortest edge of the cells of refinement level @p level (the
-     *  coarse mesh of `Subdivisions` is level 0). */
+     *  coarse mesh is level 0). */
     double
     shortest_cell_edge(unsigned int level) const;
 
-    dealii::Point<dim>        lower_corner;
-    dealii::Point<dim>        upper_corner;
-    std::vector<unsigned int> subdivisions;
-    unsigned int              initial_refinement = 0;
-    std::vector<BoundaryType> boundary_types; // one per face
+    /** Subdivisions of the bounding box into cells of the coarse mesh's
+     *  mean size: the box's own Subdivisions, for a Gmsh mesh an estimate
+     *  (sizes of meshes not yet made, the memory estimate of --check). */
+    std::vector<unsigned int>
+    equivalent_subdivisions() const;
+
+    /** The number of coarse cells. */
+    unsigned int
+    n_coarse_cells() const;
+
+    /** Whether @p x lies in the domain (on its boundary counts). */
+    bool
+    contains(const dealii::Point<dim> &x) const;
+
+    /** Adds the boundaries grains meet (wall, slip and velocity ids) to
+     *  @p walls: the box's planes, or the boundary faces of a Gmsh mesh as
+     *  facets (a quadrilateral face as two triangles in 3D). */
+    void
+    add_walls(Contact::Walls<dim> &walls) const;
+
+    /** The bounding box of the domain. */
+    dealii::Point<dim>                                 lower_corner;
+    dealii::Point<dim>                                 upper_corner;
+    std::vector<unsigned int>                          subdivisions; // box only
+    unsigned int                                       initial_refinement = 0;
+    std::map<dealii::types::boundary_id, BoundaryType> boundary_types;
+    std::string mesh_file; // Gmsh only, as a path from the working folder
+
+  private:
+    void
+    parse_box(dealii::ParameterHandler &prm, const InputLocation &where);
+
+    void
+    parse_box_conditions(const InputLocation &where,
+                         const std::string   &bc_text);
+
+    void
+    parse_id_conditions(const InputLocation &where, const std::string &bc_text);
+
+    void
+    parse_mesh_conditions(const InputLocation &where,
+                          const std::string   &bc_text);
+
+    void
+    read_mesh(const InputLocation &where, const std::string &text);
+
+    bool                                        box           = true;
+    bool                                        cartesian     = true;
+    double                                      domain_volume = 0;
+    double                                      coarse_edge   = 0;
+    std::shared_ptr<dealii::Triangulation<dim>> coarse_mesh; // Gmsh only
+    // Finds the coarse cell around a point (contains()); built on first use.
+    mutable std::shared_ptr<dealii::GridTools::Cache<dim, dim>> locator;
   };
 } // namespace ImmersedGrains
 
