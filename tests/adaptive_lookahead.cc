@@ -38,18 +38,20 @@ namespace
   void
   check(const double lookahead)
   {
-    const MPI_Comm comm = MPI_COMM_WORLD;
-    Geometry<dim>  geometry;
-    for (unsigned int d = 0; d < dim; ++d)
-    {
-      geometry.lower_corner[d] = 0;
-      geometry.upper_corner[d] = 1;
-    }
-    geometry.subdivisions.assign(dim, 4);
-    geometry.boundary_types.assign(2 * dim, BoundaryType::wall);
-    if (dim == 2)
-      geometry.boundary_types[0] = geometry.boundary_types[1] =
-        BoundaryType::periodic;
+    const MPI_Comm   comm = MPI_COMM_WORLD;
+    Geometry<dim>    geometry;
+    ParameterHandler prm;
+    Geometry<dim>::declare_parameters(prm);
+    prm.enter_subsection("Mesh");
+    prm.set("Lower corner", dim == 2 ? "0, 0" : "0, 0, 0");
+    prm.set("Upper corner", dim == 2 ? "1, 1" : "1, 1, 1");
+    prm.set("Subdivisions", "4");
+    prm.set("Initial refinement", "0");
+    prm.set("Boundary conditions",
+            dim == 2 ? "periodic, periodic, wall, wall" :
+                       "wall, wall, wall, wall, wall, wall");
+    prm.leave_subsection();
+    geometry.parse_parameters(prm, "adaptive_lookahead");
     parallel::distributed::Triangulation<dim> tria(
       comm, Triangulation<dim>::limit_level_difference_at_vertices);
     geometry.create_mesh(tria);

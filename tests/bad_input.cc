@@ -371,14 +371,50 @@ end
        dry_grain,
      "Boundary conditions",
      "periodic"},
-    {"gmsh_fluid_on_tilted_cells",
-     "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File "
-     "= " +
+    {"gmsh_manifold_off_its_curve",
+     "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File = " +
        meshes +
-       "incline_2d.msh\n set Boundary conditions = 1: "
-       "wall, 2: wall, 3: wall, 4: wall\nend\n",
-     "Enabled",
-     "axis-parallel"},
+       "incline_2d.msh\n set Boundary conditions = 1: wall, 2: wall, 3: "
+       "wall, 4: wall\n set Manifolds = 1: cylinder 0, 0\nend\n" +
+       dry_grain,
+     "Manifolds",
+     "not on one cylinder"},
+    {"gmsh_manifold_unknown_shape",
+     "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File = " +
+       meshes +
+       "incline_2d.msh\n set Boundary conditions = 1: wall, 2: wall, 3: "
+       "wall, 4: wall\n set Manifolds = 1: cone 0, 0\nend\n" +
+       dry_grain,
+     "Manifolds",
+     "cone"},
+    {"box_with_manifolds",
+     "set Dimension = 2\nsubsection Mesh\n set Manifolds = 0: sphere 0, "
+     "0\nend\n",
+     "Manifolds",
+     "0: sphere 0, 0"},
+    {"boundary_force_unknown_id",
+     "set Dimension = 2\nsubsection Output\n set Boundary forces = 7\nend\n",
+     "Boundary forces",
+     "boundary id 7"},
+    {"probe_outside",
+     "set Dimension = 2\nsubsection Output\n set Probes = far: 2, 2\nend\n",
+     "Probes",
+     "far"},
+    {"probe_without_name",
+     "set Dimension = 2\nsubsection Output\n set Probes = 0.5, 0.5\nend\n",
+     "Probes",
+     "0.5, 0.5"},
+    {"probe_without_fluid",
+     "set Dimension = 2\nsubsection Output\n set Probes = a: 0.5, "
+     "0.5\nend\n" +
+       dry_grain,
+     "Probes",
+     "needs the fluid"},
+    {"inflow_bad_expression",
+     "set Dimension = 2\nsubsection Fluid\n set Inflow velocity = 1; "
+     "sin(\nend\n",
+     "Inflow velocity",
+     "sin("},
     {"gmsh_grain_outside",
      "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File "
      "= " +

@@ -204,6 +204,12 @@ namespace ImmersedGrains
     // in their documented order, then each owner's in turn.
     static std::vector<std::string>
     statistics_columns();
+
+    // Output/Boundary forces and Output/Probes: reads them and adds their
+    // columns.
+    void
+    parse_output_points(dealii::ParameterHandler &prm,
+                        const InputLocation      &where);
     // The columns of timings.csv: the phases, each a sum of TimerOutput
     // sections.
     static std::vector<std::string>
@@ -276,8 +282,13 @@ namespace ImmersedGrains
     unsigned int                    test_every = 1;
     std::vector<TestCheck>          test_checks;
     std::vector<dealii::Point<dim>> pressure_drop_points;
-    std::string                     pressure_drop_text;
-    unsigned int                    preconditioner_builds = 0;
+    /** Output/Boundary forces and Output/Probes, with their columns. */
+    std::vector<dealii::types::boundary_id>                 boundary_force_ids;
+    std::string                                             boundary_force_text;
+    std::vector<std::pair<std::string, dealii::Point<dim>>> probes;
+    std::string                                             probe_text;
+    std::string                                             pressure_drop_text;
+    unsigned int preconditioner_builds = 0;
     // Steps whose contact solve stopped at Contacts/Max iterations.
     unsigned int capped_contact_steps = 0;
 

@@ -23,6 +23,7 @@ namespace ImmersedGrains
     const Geometry<dim>                                     &geometry)
       : triangulation(tria)
       , geometry(geometry)
+      , mapping(geometry.mapping())
       , fe(1)
       , dof_handler(tria)
   {
@@ -397,7 +398,7 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  const dealii::MappingCartesian<dim> &
+  const dealii::Mapping<dim> &
   HelmholtzFilter<dim>::get_mapping() const
   {
     return mapping;

@@ -166,11 +166,12 @@ namespace ImmersedGrains
              contrast * (*beta_min * h * h + viscous);
     }
     // The reference cell's scalar shape functions at the quadrature points.
-    // Every cell is an axis-parallel box (the mapping is MappingCartesian),
-    // so the values on a cell are these and its gradients these over the
-    // cell's extents (scale_to_cell()): computed once per assembly instead
-    // of FEValues::reinit copying all of them for every cell (3 % of the
-    // 3D cloud's run).
+    // On a mesh of axis-parallel boxes (MappingCartesian) the values on a
+    // cell are these and its gradients these over the cell's extents
+    // (scale_to_cell()); on other cells the gradients map through the
+    // Jacobian (map_to_cell()). Computed once per assembly instead of
+    // FEValues::reinit copying all of them for every cell (3 % of the 3D
+    // cloud's run).
     template <int dim>
     std::vector<ScalarShapes<dim>>
     reference_shapes(const dealii::FESystem<dim>   &fe,
@@ -230,6 +231,89 @@ namespace ImmersedGrains
             shapes[q].G[d][a] = reference[q].G[d][a] * inverse;
           for (unsigned int b = 0; b < n_p; ++b)
             shapes[q].Gp[d][b] = reference[q].Gp[d][b] * inverse;
+        }
+      }
+    }
+
+    // The bilinear (trilinear) vertex functions of the reference cell at
+    // the quadrature points: a Q1 cell's map x(xi) = sum_v X_v N_v(xi).
+    template <int dim>
+    struct VertexFunctions
+    {
+      std::vector<std::vector<double>>                 value; // [q][v]
+      std::vector<std::vector<dealii::Tensor<1, dim>>> gradient;
+    };
+
+    template <int dim>
+    VertexFunctions<dim>
+    vertex_functions(const dealii::Quadrature<dim> &quadrature)
+    {
+      constexpr unsigned int n_v = dealii::GeometryInfo<dim>::vertices_per_cell;
+      VertexFunctions<dim>   f;
+      f.value.assign(quadrature.size(), std::vector<double>(n_v));
+      f.gradient.assign(quadrature.size(),
+                        std::vector<dealii::Tensor<1, dim>>(n_v));
+      for (unsigned int q = 0; q < quadrature.size(); ++q)
+        for (unsigned int v = 0; v < n_v; ++v)
+        {
+          f.value[q][v] = dealii::GeometryInfo<dim>::d_linear_shape_function(
+            quadrature.point(q), v);
+          f.gradient[q][v] =
+            dealii::GeometryInfo<dim>::d_linear_shape_function_gradient(
+              quadrature.point(q), v);
+        }
+      return f;
+    }
+
+    // The gradients, weights and points of a cell of any shape under the
+    // Q1 map (MappingQ1's): grad N = J^{-T} grad_xi N, JxW = det J w, with
+    // J = dx/dxi at each point. A Gmsh mesh's cells that are not
+    // axis-parallel boxes take this path; boxes take scale_to_cell().
+    template <int dim, typename CellIterator>
+    void
+    map_to_cell(const CellIterator                   &cell,
+                const dealii::Quadrature<dim>        &quadrature,
+                const VertexFunctions<dim>           &vertex,
+                const std::vector<ScalarShapes<dim>> &reference,
+                std::vector<ScalarShapes<dim>>       &shapes,
+                std::vector<double>                  &JxW,
+                std::vector<dealii::Point<dim>>      &points)
+    {
+      constexpr unsigned int n_v = dealii::GeometryInfo<dim>::vertices_per_cell;
+      std::array<dealii::Point<dim>, n_v> X;
+      for (unsigned int v = 0; v < n_v; ++v)
+        X[v] = cell->vertex(v);
+      const unsigned int n_s = reference[0].N.size();
+      const unsigned int n_p = reference[0].Np.size();
+      for (unsigned int q = 0; q < quadrature.size(); ++q)
+      {
+        dealii::Tensor<2, dim> J;
+        points[q] = dealii::Point<dim>();
+        for (unsigned int v = 0; v < n_v; ++v)
+        {
+          points[q] += vertex.value[q][v] * X[v];
+          J += dealii::outer_product(X[v], vertex.gradient[q][v]);
+        }
+        const double determinant = dealii::determinant(J);
+        Assert(determinant > 0, dealii::ExcMessage("a distorted cell"));
+        JxW[q]                           = quadrature.weight(q) * determinant;
+        const dealii::Tensor<2, dim> inv = dealii::invert(J);
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          for (unsigned int a = 0; a < n_s; ++a)
+          {
+            double g = 0;
+            for (unsigned int k = 0; k < dim; ++k)
+              g += inv[k][d] * reference[q].G[k][a];
+            shapes[q].G[d][a] = g;
+          }
+          for (unsigned int b = 0; b < n_p; ++b)
+          {
+            double g = 0;
+            for (unsigned int k = 0; k < dim; ++k)
+              g += inv[k][d] * reference[q].Gp[k][b];
+            shapes[q].Gp[d][b] = g;
+          }
         }
       }
     }
@@ -554,6 +638,8 @@ namespace ImmersedGrains
     const std::vector<ScalarShapes<dim>> reference =
       reference_shapes(fe, dofs, quadrature);
     std::vector<ScalarShapes<dim>>  cell_shapes = reference;
+    const bool                      cartesian   = geometry.is_cartesian();
+    const VertexFunctions<dim>      vertex      = vertex_functions(quadrature);
     std::vector<double>             JxW_values(n_q);
     std::vector<dealii::Point<dim>> points(n_q);
     CellIntegrals                   integrals;
@@ -582,8 +668,12 @@ namespace ImmersedGrains
       if (!cell->is_locally_owned())
         continue;
       const unsigned int cell_number = owned_cell++;
-      scale_to_cell(
-        cell, quadrature, reference, cell_shapes, JxW_values, points);
+      if (cartesian)
+        scale_to_cell(
+          cell, quadrature, reference, cell_shapes, JxW_values, points);
+      else
+        map_to_cell(
+          cell, quadrature, vertex, reference, cell_shapes, JxW_values, points);
       cell_gather->gather(cell_number, solution, local.current);
       if (local.with_history)
       {

@@ -338,16 +338,7 @@ namespace ImmersedGrains
     const InputLocation where{file, "Fluid"};
     prm.enter_subsection("Fluid");
     {
-      enabled = prm.get_bool("Enabled");
-      // The assembly scales the reference cell's gradients by each cell's
-      // extents (fluid_assembly.cc), exact only on axis-parallel boxes.
-      where.require(!enabled || geometry.is_cartesian(),
-                    "Enabled",
-                    prm.get("Enabled"),
-                    "the fluid needs a mesh of axis-parallel cells, and " +
-                      geometry.mesh_file +
-                      " has others (grains alone run on it: Enabled = "
-                      "false)");
+      enabled   = prm.get_bool("Enabled");
       density   = prm.get_double("Density");
       viscosity = prm.get_double("Viscosity");
       where.require(density > 0,
@@ -460,7 +451,9 @@ namespace ImmersedGrains
           auto *const        cerr_buffer = std::cerr.rdbuf(muted.rdbuf());
           try
           {
-            function->value(dealii::Point<dim>());
+            // Every component: vector_value() compiles them all.
+            dealii::Vector<double> value(function->n_components);
+            function->vector_value(dealii::Point<dim>(), value);
           }
           catch (...)
           {

@@ -3,6 +3,7 @@
 #include <limits>
 #include <sstream>
 
+#include <deal.II/base/qprojector.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_renumbering.h>
 #include <deal.II/dofs/dof_tools.h>
@@ -118,9 +119,12 @@ namespace ImmersedGrains
     class MixtureFieldsOutput : public dealii::DataPostprocessor<dim>
     {
     public:
-      MixtureFieldsOutput(const MixtureFields<dim> &fields, const double time)
+      MixtureFieldsOutput(const MixtureFields<dim>   &fields,
+                          const double                time,
+                          const dealii::Mapping<dim> &mapping)
           : fields(fields)
           , time(time)
+          , mapping(mapping)
       {
       }
 
@@ -159,9 +163,9 @@ namespace ImmersedGrains
       }
 
     private:
-      const MixtureFields<dim>           &fields;
-      const double                        time;
-      const dealii::MappingCartesian<dim> mapping;
+      const MixtureFields<dim>   &fields;
+      const double                time;
+      const dealii::Mapping<dim> &mapping;
     };
   } // namespace
 
@@ -181,6 +185,7 @@ namespace ImmersedGrains
       , mpi_communicator(triangulation.get_communicator())
       , fe(dealii::FE_Q<dim>(2), dim, dealii::FE_Q<dim>(1), 1)
       , dof_handler(triangulation)
+      , mapping(geometry.mapping())
       , velocity_shapes(fe.base_element(0))
       , pressure_shapes(fe.base_element(1))
       , forcing(
@@ -317,6 +322,80 @@ namespace ImmersedGrains
     sum   = dealii::Utilities::MPI::sum(sum, mpi_communicator);
     count = dealii::Utilities::MPI::sum(count, mpi_communicator);
     return count > 0 ? sum / count : 0.0;
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::fluid_fraction_at(const dealii::Point<dim> &point) const
+  {
+    double             sum = 0, count = 0;
+    MixtureValues<dim> values;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->point_inside(point))
+      {
+        const dealii::Point<dim> reference =
+          mapping.transform_real_to_unit_cell(cell, point);
+        mixture_fields->evaluate(cell, {point}, {reference}, time, values);
+        sum += values.fluid_fraction[0];
+        count += 1;
+      }
+    sum   = dealii::Utilities::MPI::sum(sum, mpi_communicator);
+    count = dealii::Utilities::MPI::sum(count, mpi_communicator);
+    return count > 0 ? sum / count : 1.0;
+  }
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  FluidSolver<dim>::boundary_force(const dealii::types::boundary_id id) const
+  {
+    const dealii::QGauss<dim - 1> face_quadrature(fe.degree + 1);
+    dealii::FEFaceValues<dim>     fe_face_values(
+      mapping,
+      fe,
+      face_quadrature,
+      dealii::update_values | dealii::update_gradients |
+        dealii::update_normal_vectors | dealii::update_JxW_values |
+        dealii::update_quadrature_points);
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    const dealii::FEValuesExtractors::Scalar pressure(dim);
+    const unsigned int                       n_q = face_quadrature.size();
+    std::vector<dealii::Tensor<2, dim>>      grad_u(n_q);
+    std::vector<double>                      p(n_q);
+    std::vector<dealii::Point<dim>>          reference(n_q);
+    MixtureValues<dim>                       mixture;
+    const double                             mu = parameters.viscosity;
+    dealii::Tensor<1, dim>                   force;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->at_boundary())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) && cell->face(f)->boundary_id() == id)
+          {
+            fe_face_values.reinit(cell, f);
+            fe_face_values[velocities].get_function_gradients(solution, grad_u);
+            fe_face_values[pressure].get_function_values(solution, p);
+            // The face's points in the cell's reference coordinates, for
+            // the fluid fraction there.
+            const auto on_face = dealii::QProjector<dim>::project_to_face(
+              dealii::ReferenceCells::get_hypercube<dim>(), face_quadrature, f);
+            for (unsigned int q = 0; q < n_q; ++q)
+              reference[q] = on_face.point(q);
+            mixture_fields->evaluate(cell,
+                                     fe_face_values.get_quadrature_points(),
+                                     reference,
+                                     time,
+                                     mixture);
+            for (unsigned int q = 0; q < n_q; ++q)
+            {
+              const auto &n     = fe_face_values.normal_vector(q);
+              const auto stress = -p[q] * dealii::unit_symmetric_tensor<dim>() +
+                                  mu * (grad_u[q] + transpose(grad_u[q]));
+              force -= mixture.fluid_fraction[q] * (stress * n) *
+                       fe_face_values.JxW(q);
+            }
+          }
+    return dealii::Utilities::MPI::sum(force, mpi_communicator);
   }
 
 
@@ -994,8 +1073,9 @@ namespace ImmersedGrains
     interpretation.push_back(
       dealii::DataComponentInterpretation::component_is_scalar);
     data_out.add_data_vector(dof_handler, solution, names, interpretation);
-    output_fields =
-      std::make_unique<MixtureFieldsOutput<dim>>(*mixture_fields, time);
+    output_fields = std::make_unique<MixtureFieldsOutput<dim>>(*mixture_fields,
+                                                               time,
+                                                               mapping);
     data_out.add_data_vector(dof_handler, solution, *output_fields);
   }
 

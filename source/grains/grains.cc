@@ -78,12 +78,7 @@ namespace ImmersedGrains
       , timer(timer)
       , properties(
           make_grain_property_layout(parameters, with_fluid, straight_paths))
-      , mapping_owner(geometry.is_cartesian() ?
-                        std::unique_ptr<dealii::Mapping<dim>>(
-                          std::make_unique<dealii::MappingCartesian<dim>>()) :
-                        std::unique_ptr<dealii::Mapping<dim>>(
-                          std::make_unique<dealii::MappingQ1<dim>>()))
-      , mapping(*mapping_owner)
+      , mapping(geometry.mapping())
       , particles(tria, mapping, properties.n_properties)
       , vertex_cache(tria, mapping)
   {

@@ -40,6 +40,18 @@ namespace ImmersedGrains
 
 
   void
+  Statistics::add_columns(const std::vector<std::string> &names)
+  {
+    for (const auto &c : names)
+      if (values.count(c) == 0)
+      {
+        columns.push_back(c);
+        values[c] = 0;
+      }
+  }
+
+
+  void
   Statistics::open(const std::string &file_name,
                    const bool         is_root,
                    const int          keep_through_step)

@@ -1,9 +1,11 @@
 #include <deal.II/base/utilities.h>
+#include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/grid_tools_cache.h>
+#include <deal.II/grid/manifold_lib.h>
 
 #include <immersed_grains/mesh/geometry.h>
 
@@ -59,6 +61,14 @@ namespace ImmersedGrains
                         Anything(),
                         "The Gmsh mesh of Geometry = gmsh; a relative path is "
                         "read from the folder of the parameter file.");
+      prm.declare_entry(
+        "Manifolds",
+        "",
+        Anything(),
+        "Curved boundaries of a Gmsh mesh, kept exact under refinement and "
+        "met so by grains: 'id: cylinder x0, y0' (2D: a circle), 'id: "
+        "cylinder x0, y0, z0, ax, ay, az' (3D: a point of the axis and its "
+        "direction) or 'id: sphere x0, y0[, z0]', separated by ';'.");
       prm.declare_entry("Lower corner",
                         dim == 2 ? "0, 0" : "0, 0, 0",
                         Anything(),
@@ -107,6 +117,10 @@ namespace ImmersedGrains
       const std::string bc_text = prm.get("Boundary conditions");
       if (box)
       {
+        where.require(prm.get("Manifolds").empty(),
+                      "Manifolds",
+                      prm.get("Manifolds"),
+                      "curved boundaries need Geometry = gmsh");
         parse_box(prm, where);
         parse_box_conditions(where, bc_text);
       }
@@ -122,6 +136,7 @@ namespace ImmersedGrains
         mesh_file = path.lexically_normal().string();
         read_mesh(where, prm.get("File"));
         parse_mesh_conditions(where, bc_text);
+        parse_manifolds(where, prm.get("Manifolds"));
       }
     }
     prm.leave_subsection();
@@ -323,6 +338,135 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  dealii::Point<dim>
+  Geometry<dim>::CurvedBoundary::project(const dealii::Point<dim> &x) const
+  {
+    dealii::Tensor<1, dim> r = x - center;
+    if (!sphere && dim == 3)
+      r -= (r * axis) * axis;
+    const double length = r.norm();
+    return length > 0 ? x + (radius / length - 1) * r : x;
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::parse_manifolds(const InputLocation &where,
+                                 const std::string   &text)
+  {
+    curved_boundaries.clear();
+    for (const std::string &entry :
+         dealii::Utilities::split_string_list(text, ';'))
+    {
+      const auto colon = entry.find(':');
+      const auto fail  = [&](const std::string &why)
+      { where.fail("Manifolds", text, "'" + entry + "': " + why); };
+      if (colon == std::string::npos)
+        fail("expected 'id: cylinder ...' or 'id: sphere ...'");
+      const std::string id_text =
+        dealii::Utilities::trim(entry.substr(0, colon));
+      if (id_text.empty() ||
+          id_text.find_first_not_of("0123456789") != std::string::npos ||
+          id_text.size() > 5)
+        fail("the id is not a boundary id");
+      CurvedBoundary c;
+      c.id = static_cast<dealii::types::boundary_id>(std::stoi(id_text));
+      if (boundary_types.count(c.id) == 0)
+        fail("boundary id " + id_text + " is not on the mesh");
+      for (const auto &other : curved_boundaries)
+        if (other.id == c.id)
+          fail("boundary id " + id_text + " is given twice");
+      std::istringstream rest(entry.substr(colon + 1));
+      std::string        kind;
+      rest >> kind;
+      c.sphere = kind == "sphere";
+      if (!c.sphere && kind != "cylinder")
+        fail("unknown shape '" + kind + "' (cylinder, sphere)");
+      std::string numbers_text;
+      std::getline(rest, numbers_text);
+      std::vector<double> numbers;
+      try
+      {
+        for (const auto &n :
+             dealii::Utilities::split_string_list(numbers_text, ','))
+          numbers.push_back(std::stod(n));
+      }
+      catch (...)
+      {
+        fail("the numbers do not read");
+      }
+      const unsigned int needed = !c.sphere && dim == 3 ? 6 : dim;
+      if (numbers.size() != needed)
+        fail(kind + " needs " + std::to_string(needed) + " numbers here");
+      for (unsigned int d = 0; d < dim; ++d)
+        c.center[d] = numbers[d];
+      if (needed == 6)
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          c.axis[d] = numbers[dim + d];
+        if (c.axis.norm() == 0)
+          fail("the axis has no direction");
+        c.axis /= c.axis.norm();
+      }
+      // The radius from the vertices of the faces: a shape that does not
+      // go through them is a mistake in the file or in the entry.
+      double                 sum = 0, smallest = 1e300, largest = 0;
+      unsigned int           n = 0;
+      std::set<unsigned int> seen;
+      for (const auto &cell : coarse_mesh->active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) && cell->face(f)->boundary_id() == c.id)
+            for (const unsigned int v : cell->face(f)->vertex_indices())
+              if (seen.insert(cell->face(f)->vertex_index(v)).second)
+              {
+                dealii::Tensor<1, dim> r = cell->face(f)->vertex(v) - c.center;
+                if (!c.sphere && dim == 3)
+                  r -= (r * c.axis) * c.axis;
+                sum += r.norm();
+                smallest = std::min(smallest, r.norm());
+                largest  = std::max(largest, r.norm());
+                ++n;
+              }
+      c.radius = sum / n;
+      if (largest - smallest > 1e-3 * c.radius)
+        fail("the faces of boundary id " + id_text + " lie between " +
+             std::to_string(smallest) + " and " + std::to_string(largest) +
+             " m from the " + (c.sphere ? "centre" : "axis") + ", not on one " +
+             kind);
+      curved_boundaries.push_back(c);
+    }
+    if (!curved_boundaries.empty())
+    {
+      // Refined faces follow the curve: cells are no longer boxes.
+      cartesian = false;
+      attach_manifolds(*coarse_mesh);
+    }
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::attach_manifolds(dealii::Triangulation<dim> &tria) const
+  {
+    for (const auto &c : curved_boundaries)
+    {
+      for (const auto &cell : tria.active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) && cell->face(f)->boundary_id() == c.id)
+            cell->face(f)->set_all_manifold_ids(c.id);
+      if constexpr (dim == 3)
+        if (!c.sphere)
+        {
+          tria.set_manifold(c.id,
+                            dealii::CylindricalManifold<dim>(c.axis, c.center));
+          continue;
+        }
+      tria.set_manifold(c.id, dealii::SphericalManifold<dim>(c.center));
+    }
+  }
+
+
+  template <int dim>
   void
   Geometry<dim>::read_mesh(const InputLocation &where, const std::string &text)
   {
@@ -471,6 +615,21 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  const dealii::Mapping<dim> &
+  Geometry<dim>::mapping() const
+  {
+    if (!cell_mapping)
+    {
+      if (cartesian)
+        cell_mapping = std::make_shared<dealii::MappingCartesian<dim>>();
+      else
+        cell_mapping = std::make_shared<dealii::MappingQ1<dim>>();
+    }
+    return *cell_mapping;
+  }
+
+
+  template <int dim>
   bool
   Geometry<dim>::is_cartesian() const
   {
@@ -586,45 +745,90 @@ namespace ImmersedGrains
       walls.add_box(lower_corner, upper_corner, is_wall);
       return;
     }
-    std::map<unsigned int, unsigned int>     number; // mesh vertex -> wall's
-    std::vector<dealii::Point<dim>>          points;
-    std::vector<Contact::BoundaryFacet<dim>> facets;
-    const auto vertex = [&](const auto &face, const unsigned int v)
+    // Points numbered by position (to a billionth of the domain), so that
+    // facets of neighbouring faces share the numbers of their corners.
+    const double quantum = 1e-9 * lower_corner.distance(upper_corner);
+    std::map<std::array<long long, dim>, unsigned int> number;
+    std::vector<dealii::Point<dim>>                    points;
+    std::vector<Contact::BoundaryFacet<dim>>           facets;
+    const auto vertex = [&](const dealii::Point<dim> &x)
     {
-      const auto [entry, added] =
-        number.emplace(face->vertex_index(v), points.size());
+      std::array<long long, dim> key;
+      for (unsigned int d = 0; d < dim; ++d)
+        key[d] = std::llround(x[d] / quantum);
+      const auto [entry, added] = number.emplace(key, points.size());
       if (added)
-        points.push_back(face->vertex(v));
+        points.push_back(x);
       return entry->second;
     };
+    // A curved face as n x n pieces whose corners lie on its surface, n
+    // such that a piece's chord departs from the curve by at most 1e-4 of
+    // its radius (sagitta l^2/(8 R)); the same n for all the faces of a
+    // curve, so that neighbours share their corners.
+    std::map<dealii::types::boundary_id, unsigned int> pieces_per_edge;
+    for (const auto &c : curved_boundaries)
+    {
+      double longest = 0;
+      for (const auto &cell : coarse_mesh->active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) && cell->face(f)->boundary_id() == c.id)
+            longest = std::max(longest, cell->face(f)->diameter());
+      pieces_per_edge[c.id] = static_cast<unsigned int>(
+        std::ceil(longest / (c.radius * std::sqrt(8e-4))));
+    }
     for (const auto &cell : coarse_mesh->active_cell_iterators())
       for (const unsigned int f : cell->face_indices())
         if (cell->at_boundary(f) &&
             meets(boundary_types.at(cell->face(f)->boundary_id())))
         {
-          const auto                face = cell->face(f);
-          std::vector<unsigned int> corners;
-          for (const unsigned int v : face->vertex_indices())
-            corners.push_back(vertex(face, v));
-          // A quadrilateral's corners in deal.II's numbering go round as
-          // 0, 1, 3, 2: two triangles sharing the diagonal 0-3.
-          std::vector<std::array<unsigned int, dim>>   pieces;
-          const std::vector<std::vector<unsigned int>> corner_sets =
-            dim == 2 ?
-              std::vector<std::vector<unsigned int>>{{0, 1}} :
-              std::vector<std::vector<unsigned int>>{{0, 1, 3}, {0, 3, 2}};
-          for (const auto &set : corner_sets)
+          const auto            face  = cell->face(f);
+          const CurvedBoundary *curve = nullptr;
+          for (const auto &c : curved_boundaries)
+            if (c.id == face->boundary_id())
+              curve = &c;
+          const unsigned int n = curve ? pieces_per_edge[curve->id] : 1;
+          // The face's point at parameters (s, t) in [0, 1]^(dim-1).
+          const auto at = [&](const double s, const double t)
           {
-            std::array<unsigned int, dim> piece;
-            for (unsigned int a = 0; a < dim; ++a)
-              piece[a] = corners[set[a]];
-            pieces.push_back(piece);
-          }
+            dealii::Point<dim> x;
+            if (dim == 2)
+              x = face->vertex(0) + s * (face->vertex(1) - face->vertex(0));
+            else
+              x = dealii::Point<dim>((1 - s) * (1 - t) * face->vertex(0) +
+                                     s * (1 - t) * face->vertex(1) +
+                                     (1 - s) * t * face->vertex(dim - 1) +
+                                     s * t * face->vertex(dim == 3 ? 3 : 1));
+            return curve ? curve->project(x) : x;
+          };
+          // Pieces: segments in 2D, two triangles per quadrilateral in 3D
+          // (split along the diagonal from its first corner).
+          std::vector<std::array<unsigned int, dim>> pieces;
+          for (unsigned int i = 0; i < n; ++i)
+            for (unsigned int j = 0; j < (dim == 2 ? 1u : n); ++j)
+            {
+              const double s0 = double(i) / n, s1 = double(i + 1) / n;
+              const double t0 = double(j) / n, t1 = double(j + 1) / n;
+              std::array<unsigned int, dim> piece;
+              if constexpr (dim == 2)
+              {
+                piece = {{vertex(at(s0, 0)), vertex(at(s1, 0))}};
+                pieces.push_back(piece);
+              }
+              else
+              {
+                const unsigned int a = vertex(at(s0, t0)),
+                                   b = vertex(at(s1, t0)),
+                                   c = vertex(at(s0, t1)),
+                                   d = vertex(at(s1, t1));
+                pieces.push_back({{a, b, d}});
+                pieces.push_back({{a, d, c}});
+              }
+            }
           for (const auto &piece : pieces)
           {
             dealii::Tensor<1, dim> normal;
             const auto             e = points[piece[1]] - points[piece[0]];
-            if (dim == 2)
+            if constexpr (dim == 2)
             {
               normal[0] = -e[1];
               normal[1] = e[0];
@@ -736,6 +940,7 @@ namespace ImmersedGrains
     if (!box)
     {
       tria.copy_triangulation(*coarse_mesh);
+      attach_manifolds(tria);
       return;
     }
     dealii::GridGenerator::subdivided_hyper_rectangle(

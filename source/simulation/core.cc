@@ -141,6 +141,22 @@ namespace ImmersedGrains
                         "run, printed as yes/no in test mode, separated by "
                         "';': 'column < v', 'column > v', 'column in [a, "
                         "b]'.");
+      prm.declare_entry(
+        "Boundary forces",
+        "",
+        Anything(),
+        "Boundary ids (comma list) whose force from the fluid is recorded: "
+        "columns boundary_force_<id>_x, _y[, _z], the integral of -phi "
+        "sigma n over those faces [N; N/m in 2D], sigma = -p I + mu (grad u "
+        "+ grad u^T) with p the pressure without its hydrostatic part, n "
+        "the fluid's outward normal.");
+      prm.declare_entry(
+        "Probes",
+        "",
+        Anything(),
+        "Named points 'name: x, y[, z]' separated by ';': columns "
+        "probe_<name>_pressure (the pressure without its hydrostatic part, "
+        "Pa) and probe_<name>_solid_fraction (1 - phi) there.");
       prm.declare_entry("Pressure drop points",
                         "",
                         Anything(),
@@ -220,6 +236,7 @@ namespace ImmersedGrains
         progress_interval,
         !quiet && !verbose &&
           dealii::Utilities::MPI::this_mpi_process(comm) == 0);
+      parse_output_points(prm, where);
       test_columns =
         dealii::Utilities::split_string_list(prm.get("Test columns"));
       for (const auto &c : test_columns)
@@ -251,7 +268,25 @@ namespace ImmersedGrains
                                             "Pressure drop points",
                                             pressure_drop_text,
                                             "a point lies outside the mesh");
+    for (const auto id : boundary_force_ids)
+      InputLocation{file, "Output"}.require(
+        geometry.boundary_types.count(id) == 1,
+        "Boundary forces",
+        boundary_force_text,
+        "boundary id " + std::to_string(id) + " is not on the mesh");
+    for (const auto &[name, point] : probes)
+      InputLocation{file, "Output"}.require(geometry.contains(point),
+                                            "Probes",
+                                            probe_text,
+                                            "probe '" + name +
+                                              "' lies outside the mesh");
     fluid_parameters.parse_parameters(prm, file, geometry);
+    InputLocation{file, "Output"}.require(
+      fluid_parameters.enabled ||
+        (boundary_force_ids.empty() && probes.empty()),
+      boundary_force_ids.empty() ? "Probes" : "Boundary forces",
+      boundary_force_ids.empty() ? probe_text : boundary_force_text,
+      "needs the fluid (Fluid/Enabled = true)");
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);

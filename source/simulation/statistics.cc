@@ -103,6 +103,59 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  void
+  Simulation<dim>::parse_output_points(dealii::ParameterHandler &prm,
+                                       const InputLocation      &where)
+  {
+    static const char *const axes[] = {"_x", "_y", "_z"};
+    std::vector<std::string> columns;
+    boundary_force_text = prm.get("Boundary forces");
+    for (const double id :
+         parse_double_list(boundary_force_text, where, "Boundary forces"))
+    {
+      where.require(id >= 0 && id == std::floor(id) &&
+                      id < dealii::numbers::internal_face_boundary_id,
+                    "Boundary forces",
+                    boundary_force_text,
+                    "boundary ids are whole numbers from 0");
+      boundary_force_ids.push_back(static_cast<dealii::types::boundary_id>(id));
+      for (unsigned int d = 0; d < dim; ++d)
+        columns.push_back("boundary_force_" +
+                          std::to_string(boundary_force_ids.back()) + axes[d]);
+    }
+    probe_text = prm.get("Probes");
+    for (const std::string &entry :
+         dealii::Utilities::split_string_list(probe_text, ';'))
+    {
+      const auto        colon = entry.find(':');
+      const std::string name =
+        colon == std::string::npos ?
+          "" :
+          dealii::Utilities::trim(entry.substr(0, colon));
+      where.require(!name.empty() &&
+                      name.find_first_not_of(
+                        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                        "0123456789_") == std::string::npos,
+                    "Probes",
+                    probe_text,
+                    "'" + entry +
+                      "' is not 'name: x, y[, z]' with a name of letters, "
+                      "digits and _");
+      for (const auto &[other, point] : probes)
+        where.require(other != name,
+                      "Probes",
+                      probe_text,
+                      "probe '" + name + "' is named twice");
+      probes.emplace_back(
+        name, parse_point<dim>(entry.substr(colon + 1), where, "Probes"));
+      columns.push_back("probe_" + name + "_pressure");
+      columns.push_back("probe_" + name + "_solid_fraction");
+    }
+    statistics.add_columns(columns);
+  }
+
+
+  template <int dim>
   std::vector<std::string>
   Simulation<dim>::timing_columns()
   {
@@ -166,6 +219,20 @@ namespace ImmersedGrains
                        fluid->pressure_at(pressure_drop_points[1]));
     statistics.set("solid_volume",
                    coupling ? coupling->solid_volume() : volume - fluid_volume);
+    static const char *const axes[] = {"_x", "_y", "_z"};
+    for (const auto id : boundary_force_ids)
+    {
+      const auto force = fluid->boundary_force(id);
+      for (unsigned int d = 0; d < dim; ++d)
+        statistics.set("boundary_force_" + std::to_string(id) + axes[d],
+                       force[d]);
+    }
+    for (const auto &[name, point] : probes)
+    {
+      statistics.set("probe_" + name + "_pressure", fluid->pressure_at(point));
+      statistics.set("probe_" + name + "_solid_fraction",
+                     1 - fluid->fluid_fraction_at(point));
+    }
   }
 
 
@@ -305,16 +372,18 @@ namespace ImmersedGrains
 
 
 
-#define IMMERSED_GRAINS_INSTANTIATE(dim)                                         \
-  template std::vector<std::string> Simulation<dim>::statistics_columns();       \
-  template std::vector<std::string> Simulation<dim>::timing_columns();           \
-  template void                     Simulation<dim>::postprocess(double);        \
-  template void                     Simulation<dim>::set_fluid_statistics();     \
-  template void                     Simulation<dim>::set_grain_statistics();     \
-  template void                     Simulation<dim>::set_cloud_statistics();     \
-  template void                     Simulation<dim>::print_progress(bool);       \
-  template void                     Simulation<dim>::print_test_row(bool) const; \
-  template void                     Simulation<dim>::record_timings();
+#define IMMERSED_GRAINS_INSTANTIATE(dim)                                    \
+  template std::vector<std::string> Simulation<dim>::statistics_columns();  \
+  template std::vector<std::string> Simulation<dim>::timing_columns();      \
+  template void                     Simulation<dim>::parse_output_points(   \
+    dealii::ParameterHandler &, const InputLocation &); \
+  template void Simulation<dim>::postprocess(double);                       \
+  template void Simulation<dim>::set_fluid_statistics();                    \
+  template void Simulation<dim>::set_grain_statistics();                    \
+  template void Simulation<dim>::set_cloud_statistics();                    \
+  template void Simulation<dim>::print_progress(bool);                      \
+  template void Simulation<dim>::print_test_row(bool) const;                \
+  template void Simulation<dim>::record_timings();
 
   IMMERSED_GRAINS_INSTANTIATE(2)
   IMMERSED_GRAINS_INSTANTIATE(3)

@@ -5,7 +5,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_q.h>
-#include <deal.II/fe/mapping_cartesian.h>
+#include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -120,7 +120,7 @@ namespace ImmersedGrains
     const dealii::FE_Q<dim> &
     get_fe() const;
 
-    const dealii::MappingCartesian<dim> &
+    const dealii::Mapping<dim> &
     get_mapping() const;
 
     const dealii::IndexSet &
@@ -129,9 +129,9 @@ namespace ImmersedGrains
   private:
     const dealii::parallel::distributed::Triangulation<dim> &triangulation;
     const Geometry<dim>                                     &geometry;
+    const dealii::Mapping<dim>                              &mapping;
     dealii::FE_Q<dim>                                        fe;
     dealii::DoFHandler<dim>                                  dof_handler;
-    dealii::MappingCartesian<dim>                            mapping;
     dealii::AffineConstraints<double>                        constraints;
     dealii::IndexSet                                         owned, relevant;
     dealii::TrilinosWrappers::SparseMatrix                   matrix;

@@ -187,6 +187,19 @@ namespace ImmersedGrains
     double
     pressure_at(const dealii::Point<dim> &point) const;
 
+    /** The fluid fraction phi at @p point (collective). */
+    double
+    fluid_fraction_at(const dealii::Point<dim> &point) const;
+
+    /**
+     * The force of the fluid on the boundary parts with id @p id (per unit
+     * depth in 2D): -integral of phi sigma n, with sigma = -p I + mu (grad
+     * u + grad u^T), p without its hydrostatic part and n the fluid's
+     * outward normal. Collective.
+     */
+    dealii::Tensor<1, dim>
+    boundary_force(dealii::types::boundary_id id) const;
+
     /** The largest velocity component at a node (collective). */
     double
     max_velocity() const;
@@ -307,7 +320,10 @@ namespace ImmersedGrains
     // cost (constant Jacobians, a closed-form inverse; MappingQ1 also
     // rebuilt its support points for every FEValues object,
     // doc/performance.md).
-    dealii::MappingCartesian<dim> mapping;
+    // Geometry::mapping(): the Cartesian map on meshes of axis-parallel
+    // cells (MappingQ1 rebuilt its support points for every FEValues
+    // object, doc/performance.md), MappingQ1 on others.
+    const dealii::Mapping<dim>   &mapping;
     std::vector<dealii::IndexSet> owned_partitioning;
     std::vector<dealii::IndexSet> relevant_partitioning;
 

@@ -354,11 +354,8 @@ namespace ImmersedGrains
     MPI_Comm                                                 comm;
     dealii::TimerOutput                                     &timer;
 
-    // MappingCartesian where every cell is an axis-parallel box (exact, and
-    // a closed-form inverse), MappingQ1 on other meshes.
     GrainPropertyLayout                     properties;
-    std::unique_ptr<dealii::Mapping<dim>>   mapping_owner;
-    const dealii::Mapping<dim>             &mapping;
+    const dealii::Mapping<dim>             &mapping; // Geometry::mapping()
     dealii::Particles::ParticleHandler<dim> particles;
     /// Cells around each vertex, for rescue_lost_grain() (built on first
     /// use, rebuilt when the mesh changes).

@@ -22,6 +22,11 @@ namespace ImmersedGrains
   public:
     explicit Statistics(std::vector<std::string> columns);
 
+    /** Appends a scene's own columns (forces on its boundaries, its
+     *  probes) after the declared ones; before open(). */
+    void
+    add_columns(const std::vector<std::string> &names);
+
     /** Opens DIR/statistics.csv and writes the header (rank 0 only).
      *  With @p keep_through_step >= 0 (a resumed run) the rows the file
      *  has up to that step are kept and new rows appended; later ones (of

@@ -4,6 +4,7 @@
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
 #include <deal.II/distributed/tria.h>
+#include <deal.II/fe/mapping.h>
 
 #include <immersed_grains/contact/walls.h>
 #include <immersed_grains/parameters.h>
@@ -139,6 +140,13 @@ namespace ImmersedGrains
     bool
     contains(const dealii::Point<dim> &x) const;
 
+    /** The mapping of the mesh's cells: MappingCartesian where every cell
+     *  is an axis-parallel box (exact there, with constant Jacobians and a
+     *  closed-form inverse, a fraction of MappingQ1's cost), MappingQ1
+     *  elsewhere. */
+    const dealii::Mapping<dim> &
+    mapping() const;
+
     /** Adds the boundaries grains meet (wall, slip and velocity ids) to
      *  @p walls: the box's planes, or the boundary faces of a Gmsh mesh as
      *  facets (a quadrilateral face as two triangles in 3D). */
@@ -152,6 +160,22 @@ namespace ImmersedGrains
     unsigned int                                       initial_refinement = 0;
     std::map<dealii::types::boundary_id, BoundaryType> boundary_types;
     std::string mesh_file; // Gmsh only, as a path from the working folder
+
+    /** The exact shape of a curved boundary (Mesh/Manifolds): a cylinder
+     *  (a circle in 2D) or a sphere, by boundary id. */
+    struct CurvedBoundary
+    {
+      dealii::types::boundary_id id;
+      bool                       sphere;
+      dealii::Point<dim>         center;
+      dealii::Tensor<1, dim>     axis;       // a cylinder's in 3D, unit length
+      double                     radius = 0; // the mean over its vertices
+
+      /** The point of the surface closest to @p x. */
+      dealii::Point<dim>
+      project(const dealii::Point<dim> &x) const;
+    };
+    std::vector<CurvedBoundary> curved_boundaries;
 
   private:
     void
@@ -171,6 +195,13 @@ namespace ImmersedGrains
     void
     read_mesh(const InputLocation &where, const std::string &text);
 
+    void
+    parse_manifolds(const InputLocation &where, const std::string &text);
+
+    /** Gives the faces of the curved boundaries their manifolds. */
+    void
+    attach_manifolds(dealii::Triangulation<dim> &tria) const;
+
     bool                                        box           = true;
     bool                                        cartesian     = true;
     double                                      domain_volume = 0;
@@ -178,6 +209,7 @@ namespace ImmersedGrains
     std::shared_ptr<dealii::Triangulation<dim>> coarse_mesh; // Gmsh only
     // Finds the coarse cell around a point (contains()); built on first use.
     mutable std::shared_ptr<dealii::GridTools::Cache<dim, dim>> locator;
+    mutable std::shared_ptr<const dealii::Mapping<dim>>         cell_mapping;
   };
 } // namespace ImmersedGrains
 
