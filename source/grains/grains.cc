@@ -124,6 +124,28 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  dealii::Point<dim>
+  Grains<dim>::reference_point(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+    const dealii::Point<dim>                                        &x) const
+  {
+    try
+    {
+      return mapping.transform_real_to_unit_cell(cell, x);
+    }
+    catch (const typename dealii::Mapping<dim>::ExcTransformationFailed &)
+    {
+      // MappingQ1's Newton iteration fails for points far outside a
+      // curved or skewed cell: such a point is in none of its cells.
+      dealii::Point<dim> far;
+      for (unsigned int d = 0; d < dim; ++d)
+        far[d] = std::numeric_limits<double>::max();
+      return far;
+    }
+  }
+
+
+  template <int dim>
   std::tuple<typename dealii::Triangulation<dim>::active_cell_iterator,
              dealii::Point<dim>,
              double>
@@ -140,9 +162,8 @@ namespace ImmersedGrains
       {
         if (!candidate->is_locally_owned())
           continue;
-        const dealii::Point<dim> p =
-          mapping.transform_real_to_unit_cell(candidate, x);
-        const double distance =
+        const dealii::Point<dim> p = reference_point(candidate, x);
+        const double             distance =
           dealii::GeometryInfo<dim>::distance_to_unit_cell(p);
         if (distance < best)
         {
@@ -857,7 +878,7 @@ namespace ImmersedGrains
       {
         p->set_location(x);
         const dealii::Point<dim> reference =
-          mapping.transform_real_to_unit_cell(p->get_surrounding_cell(), x);
+          reference_point(p->get_surrounding_cell(), x);
         in_cell = dealii::GeometryInfo<dim>::is_inside_unit_cell(reference);
         if (in_cell)
           p->set_reference_location(reference);

@@ -342,6 +342,13 @@ namespace ImmersedGrains
     is_fixed(const dealii::Particles::ParticleAccessor<dim> &particle) const;
 
   private:
+    /// @p x in the reference coordinates of @p cell; a point beyond any
+    /// cell's where the mapping cannot invert (far outside a skewed cell).
+    dealii::Point<dim>
+    reference_point(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const dealii::Point<dim>                                        &x) const;
+
     /// The longest step in which no grain at speed up to @p v_max moves
     /// more than the Max displacement fraction of @p r_min or half the
     /// shortest cell edge.
