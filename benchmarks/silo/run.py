@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Discharge of the 2D silo of prm/silo_discharge_2d.prm through orifices of
-D = 4 to 12 mean grain diameters, and Beverloo's law fitted to the rates.
+D = 6 to 14 mean grain diameters, and Beverloo's law fitted to the rates.
 
     /usr/bin/python3 benchmarks/silo/run.py [--ranks N] [--widths 0.04,0.06]
 
@@ -34,9 +34,12 @@ def run(width, ranks):
     os.makedirs(folder, exist_ok=True)
     mesh = os.path.join(folder, "silo.msh")
     with open(mesh, "w") as f:
+        # Cells of 1 cm, so that every width is a centred whole number of
+        # them.
         subprocess.run([sys.executable,
                         os.path.join(ROOT, "prm", "meshes", "silo_2d.py"),
-                        str(width)], stdout=f, check=True)
+                        str(width), "0.4", "0.8", "0.01"], stdout=f,
+                       check=True)
     with open(os.path.join(ROOT, "prm", "silo_discharge_2d.prm")) as f:
         text = f.read()
     text = text.replace("set File                = meshes/silo_2d.msh",
@@ -68,7 +71,7 @@ def run(width, ranks):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--ranks", type=int, default=1)
-    parser.add_argument("--widths", default="0.04,0.06,0.08,0.1,0.12")
+    parser.add_argument("--widths", default="0.06,0.08,0.1,0.12,0.14")
     args = parser.parse_args()
     widths = [float(w) for w in args.widths.split(",")]
     results = []
