@@ -290,10 +290,58 @@ namespace ImmersedGrains
   {
     if (!geometry.is_box())
     {
+      // Buckets about a coarse cell wide over the bounding box, each with
+      // the coarse cells whose boxes reach into it.
       for (const auto &cell : triangulation.cell_iterators_on_level(0))
       {
         coarse.push_back(cell);
         coarse_boxes.push_back(cell->bounding_box());
+      }
+      const auto &lo = geometry.lower_corner;
+      const auto &hi = geometry.upper_corner;
+      bucket_size    = std::pow(geometry.volume() / coarse.size(), 1.0 / dim);
+      std::size_t total = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        n_buckets[d] =
+          static_cast<unsigned int>((hi[d] - lo[d]) / bucket_size) + 1;
+        total *= n_buckets[d];
+      }
+      coarse_in_bucket.assign(total, {});
+      for (unsigned int k = 0; k < coarse.size(); ++k)
+      {
+        const auto &[a, b] = coarse_boxes[k].get_boundary_points();
+        std::array<unsigned int, dim> from, to;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          from[d] = std::min<unsigned int>(n_buckets[d] - 1,
+                                           static_cast<unsigned int>(
+                                             std::max(0.0, a[d] - lo[d]) /
+                                             bucket_size));
+          to[d]   = std::min<unsigned int>(n_buckets[d] - 1,
+                                         static_cast<unsigned int>(
+                                           std::max(0.0, b[d] - lo[d]) /
+                                           bucket_size));
+        }
+        std::array<unsigned int, dim> index = from;
+        for (;;)
+        {
+          std::size_t bucket = 0, stride = 1;
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            bucket += stride * index[d];
+            stride *= n_buckets[d];
+          }
+          coarse_in_bucket[bucket].push_back(k);
+          unsigned int d = 0;
+          for (; d < dim; ++d)
+            if (++index[d] <= to[d])
+              break;
+            else
+              index[d] = from[d];
+          if (d == dim)
+            break;
+        }
       }
       return;
     }
@@ -365,24 +413,53 @@ namespace ImmersedGrains
   typename dealii::Triangulation<dim>::active_cell_iterator
   Adaptivity<dim>::mesh_cell_at(const dealii::Point<dim> &point) const
   {
-    // The coarse cells whose boxes hold the point, then down the tree of
-    // the one that holds it. Axis-parallel cells are their boxes.
-    const bool cartesian = geometry.is_cartesian();
-    const auto inside    = [&](const auto &cell)
+    // The bucket of the point, then its coarse cells one by one, then
+    // down the tree of the one that holds it. Axis-parallel cells are their
+    // boxes, taken half-open as on a box (a point on a face belongs to the
+    // cell above it), and their children are numbered as a box's.
+    const auto &lo     = geometry.lower_corner;
+    const auto &hi     = geometry.upper_corner;
+    std::size_t bucket = 0, stride = 1;
+    for (unsigned int d = 0; d < dim; ++d)
     {
-      return cartesian ? cell->bounding_box().point_inside(point) :
-                         cell->point_inside(point);
+      if (point[d] < lo[d] || point[d] > hi[d])
+        return triangulation.end();
+      bucket +=
+        stride * std::min<std::size_t>(n_buckets[d] - 1,
+                                       static_cast<std::size_t>(
+                                         (point[d] - lo[d]) / bucket_size));
+      stride *= n_buckets[d];
+    }
+    const bool cartesian = geometry.is_cartesian();
+    const auto holds     = [&](const dealii::BoundingBox<dim> &box)
+    {
+      const auto &[a, b] = box.get_boundary_points();
+      for (unsigned int d = 0; d < dim; ++d)
+        if (point[d] < a[d] || point[d] > b[d] ||
+            (point[d] == b[d] && b[d] < hi[d]))
+          return false;
+      return true;
     };
-    for (unsigned int k = 0; k < coarse.size(); ++k)
-      if (coarse_boxes[k].point_inside(point) && inside(coarse[k]))
+    for (const unsigned int k : coarse_in_bucket[bucket])
+      if (holds(coarse_boxes[k]) &&
+          (cartesian || coarse[k]->point_inside(point)))
       {
         typename dealii::Triangulation<dim>::cell_iterator cell = coarse[k];
         while (cell->has_children())
         {
-          unsigned int c = 0;
-          while (c + 1 < cell->n_children() && !inside(cell->child(c)))
-            ++c;
-          cell = cell->child(c);
+          unsigned int child = 0;
+          if (cartesian)
+          {
+            const dealii::Point<dim> centre = cell->center();
+            for (unsigned int d = 0; d < dim; ++d)
+              if (point[d] >= centre[d])
+                child |= 1u << d;
+          }
+          else
+            while (child + 1 < cell->n_children() &&
+                   !cell->child(child)->point_inside(point))
+              ++child;
+          cell = cell->child(child);
         }
         return typename dealii::Triangulation<dim>::active_cell_iterator(cell);
       }

@@ -939,7 +939,12 @@ namespace ImmersedGrains
   {
     if (!box)
     {
-      tria.copy_triangulation(*coarse_mesh);
+      // From the coarse mesh's description, as a generated box is made
+      // (copy_triangulation() left p4est coarsening flags it could not
+      // carry out, and the adaptive mesh looped on them).
+      auto [vertices, cells, faces] =
+        dealii::GridTools::get_coarse_mesh_description(*coarse_mesh);
+      tria.create_triangulation(vertices, cells, faces);
       attach_manifolds(tria);
       return;
     }
