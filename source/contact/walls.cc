@@ -198,7 +198,22 @@ namespace ImmersedGrains
         }
       }
 
-      // Buckets about the size of a facet, at most a few per facet.
+      // Buckets about the size of a facet.
+      std::vector<dealii::BoundingBox<dim>> boxes;
+      double                                mean_extent = 0;
+      for (const auto &facet : facets)
+      {
+        std::vector<Point<dim>> corners;
+        double                  extent = 0;
+        for (const unsigned int v : facet.vertices)
+        {
+          for (const auto &c : corners)
+            extent = std::max(extent, c.distance(vertices[v]));
+          corners.push_back(vertices[v]);
+        }
+        boxes.emplace_back(corners);
+        mean_extent += extent / facets.size();
+      }
       Point<dim> lo = vertices[0], hi = vertices[0];
       for (const auto &v : vertices)
         for (unsigned int d = 0; d < dim; ++d)
@@ -206,125 +221,8 @@ namespace ImmersedGrains
           lo[d] = std::min(lo[d], v[d]);
           hi[d] = std::max(hi[d], v[d]);
         }
-      double mean_extent = 0, span = 0;
-      for (const auto &facet : facets)
-      {
-        double extent = 0;
-        for (unsigned int a = 0; a < dim; ++a)
-          for (unsigned int b = a + 1; b < dim; ++b)
-            extent = std::max(extent,
-                              vertices[facet.vertices[a]].distance(
-                                vertices[facet.vertices[b]]));
-        mean_extent += extent / facets.size();
-      }
-      for (unsigned int d = 0; d < dim; ++d)
-        span = std::max(span, hi[d] - lo[d]);
-      bucket_size = std::max(mean_extent, 1e-6 * span);
-      if (bucket_size <= 0)
-        bucket_size = 1;
-      for (;;)
-      {
-        std::size_t total = 1;
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          n_buckets[d] =
-            static_cast<unsigned int>((hi[d] - lo[d]) / bucket_size) + 1;
-          total *= n_buckets[d];
-        }
-        if (total <= 8 * facets.size() + 64)
-          break;
-        bucket_size *= 1.5;
-      }
-      grid_origin       = lo;
-      std::size_t total = 1;
-      for (unsigned int d = 0; d < dim; ++d)
-        total *= n_buckets[d];
-      buckets.assign(total, {});
-      for (unsigned int f = 0; f < facets.size(); ++f)
-      {
-        std::array<unsigned int, dim> from, to;
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          double a = vertices[facets[f].vertices[0]][d], b = a;
-          for (const unsigned int v : facets[f].vertices)
-          {
-            a = std::min(a, vertices[v][d]);
-            b = std::max(b, vertices[v][d]);
-          }
-          from[d] = std::min<unsigned int>(n_buckets[d] - 1,
-                                           static_cast<unsigned int>(
-                                             (a - lo[d]) / bucket_size));
-          to[d]   = std::min<unsigned int>(n_buckets[d] - 1,
-                                         static_cast<unsigned int>(
-                                           (b - lo[d]) / bucket_size));
-        }
-        std::array<unsigned int, dim> k = from;
-        for (;;)
-        {
-          std::size_t index = 0, stride = 1;
-          for (unsigned int d = 0; d < dim; ++d)
-          {
-            index += k[d] * stride;
-            stride *= n_buckets[d];
-          }
-          buckets[index].push_back(f);
-          unsigned int d = 0;
-          for (; d < dim; ++d)
-            if (++k[d] <= to[d])
-              break;
-            else
-              k[d] = from[d];
-          if (d == dim)
-            break;
-        }
-      }
+      facet_buckets.reinit(lo, hi, mean_extent, boxes);
       return first_wall;
-    }
-
-
-
-    template <int dim>
-    void
-    Walls<dim>::facets_near(const Point<dim>          &x,
-                            const double               reach,
-                            std::vector<unsigned int> &candidates) const
-    {
-      candidates.clear();
-      std::array<unsigned int, dim> from, to;
-      for (unsigned int d = 0; d < dim; ++d)
-      {
-        const double a = (x[d] - reach - grid_origin[d]) / bucket_size,
-                     b = (x[d] + reach - grid_origin[d]) / bucket_size;
-        if (b < 0 || a >= n_buckets[d])
-          return;
-        from[d] = a < 0 ? 0 : static_cast<unsigned int>(a);
-        to[d]   = std::min<unsigned int>(n_buckets[d] - 1,
-                                       static_cast<unsigned int>(b));
-      }
-      std::array<unsigned int, dim> k = from;
-      for (;;)
-      {
-        std::size_t index = 0, stride = 1;
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          index += k[d] * stride;
-          stride *= n_buckets[d];
-        }
-        candidates.insert(candidates.end(),
-                          buckets[index].begin(),
-                          buckets[index].end());
-        unsigned int d = 0;
-        for (; d < dim; ++d)
-          if (++k[d] <= to[d])
-            break;
-          else
-            k[d] = from[d];
-        if (d == dim)
-          break;
-      }
-      std::sort(candidates.begin(), candidates.end());
-      candidates.erase(std::unique(candidates.begin(), candidates.end()),
-                       candidates.end());
     }
 
 
@@ -425,9 +323,9 @@ namespace ImmersedGrains
       if (facets.empty())
         return;
       const double reach = radius + std::max(alert, 0.);
-      facets_near(x, reach, candidates);
+      facet_buckets.near(x, reach, candidates);
       // Distances that differ by less than this are the same point.
-      const double same = 1e-12 * std::max(radius, bucket_size);
+      const double same = 1e-12 * std::max(radius, reach);
       for (const unsigned int f : candidates)
       {
         const ClosestPoint closest = closest_point(f, x);

@@ -297,52 +297,11 @@ namespace ImmersedGrains
         coarse.push_back(cell);
         coarse_boxes.push_back(cell->bounding_box());
       }
-      const auto &lo = geometry.lower_corner;
-      const auto &hi = geometry.upper_corner;
-      bucket_size    = std::pow(geometry.volume() / coarse.size(), 1.0 / dim);
-      std::size_t total = 1;
-      for (unsigned int d = 0; d < dim; ++d)
-      {
-        n_buckets[d] =
-          static_cast<unsigned int>((hi[d] - lo[d]) / bucket_size) + 1;
-        total *= n_buckets[d];
-      }
-      coarse_in_bucket.assign(total, {});
-      for (unsigned int k = 0; k < coarse.size(); ++k)
-      {
-        const auto &[a, b] = coarse_boxes[k].get_boundary_points();
-        std::array<unsigned int, dim> from, to;
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          from[d] = std::min<unsigned int>(n_buckets[d] - 1,
-                                           static_cast<unsigned int>(
-                                             std::max(0.0, a[d] - lo[d]) /
-                                             bucket_size));
-          to[d]   = std::min<unsigned int>(n_buckets[d] - 1,
-                                         static_cast<unsigned int>(
-                                           std::max(0.0, b[d] - lo[d]) /
-                                           bucket_size));
-        }
-        std::array<unsigned int, dim> index = from;
-        for (;;)
-        {
-          std::size_t bucket = 0, stride = 1;
-          for (unsigned int d = 0; d < dim; ++d)
-          {
-            bucket += stride * index[d];
-            stride *= n_buckets[d];
-          }
-          coarse_in_bucket[bucket].push_back(k);
-          unsigned int d = 0;
-          for (; d < dim; ++d)
-            if (++index[d] <= to[d])
-              break;
-            else
-              index[d] = from[d];
-          if (d == dim)
-            break;
-        }
-      }
+      coarse_buckets.reinit(geometry.lower_corner,
+                            geometry.upper_corner,
+                            std::pow(geometry.volume() / coarse.size(),
+                                     1.0 / dim),
+                            coarse_boxes);
       return;
     }
     // The coarse mesh is the box's Subdivisions (Geometry), whatever the
@@ -417,19 +376,11 @@ namespace ImmersedGrains
     // down the tree of the one that holds it. Axis-parallel cells are their
     // boxes, taken half-open as on a box (a point on a face belongs to the
     // cell above it), and their children are numbered as a box's.
-    const auto &lo     = geometry.lower_corner;
-    const auto &hi     = geometry.upper_corner;
-    std::size_t bucket = 0, stride = 1;
+    const auto &lo = geometry.lower_corner;
+    const auto &hi = geometry.upper_corner;
     for (unsigned int d = 0; d < dim; ++d)
-    {
       if (point[d] < lo[d] || point[d] > hi[d])
         return triangulation.end();
-      bucket +=
-        stride * std::min<std::size_t>(n_buckets[d] - 1,
-                                       static_cast<std::size_t>(
-                                         (point[d] - lo[d]) / bucket_size));
-      stride *= n_buckets[d];
-    }
     const bool cartesian = geometry.is_cartesian();
     const auto holds     = [&](const dealii::BoundingBox<dim> &box)
     {
@@ -440,7 +391,7 @@ namespace ImmersedGrains
           return false;
       return true;
     };
-    for (const unsigned int k : coarse_in_bucket[bucket])
+    for (const unsigned int k : coarse_buckets.at(point))
       if (holds(coarse_boxes[k]) &&
           (cartesian || coarse[k]->point_inside(point)))
       {

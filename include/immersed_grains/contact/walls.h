@@ -4,6 +4,8 @@
 #include <deal.II/base/point.h>
 #include <deal.II/base/tensor.h>
 
+#include <immersed_grains/box_buckets.h>
+
 #include <array>
 #include <map>
 #include <utility>
@@ -178,11 +180,6 @@ namespace ImmersedGrains
                           std::vector<unsigned int>     &candidates,
                           std::vector<WallContact<dim>> &contacts) const;
 
-      void
-      facets_near(const Point<dim>          &x,
-                  const double               reach,
-                  std::vector<unsigned int> &candidates) const;
-
       std::vector<PlaneWall<dim>> planes;
       std::vector<unsigned int>   plane_walls; // wall number of each plane
       std::vector<Tensor<1, dim>> wall_velocities;
@@ -195,12 +192,7 @@ namespace ImmersedGrains
       std::map<std::pair<unsigned int, unsigned int>, std::vector<unsigned int>>
         edge_facets;
 
-      // A uniform grid of buckets over the facets' bounding box, each
-      // bucket holding the facets whose bounding boxes reach into it.
-      Point<dim>                             grid_origin;
-      double                                 bucket_size = 1;
-      std::array<unsigned int, dim>          n_buckets;
-      std::vector<std::vector<unsigned int>> buckets;
+      BoxBuckets<dim> facet_buckets;
     };
   } // namespace Contact
 } // namespace ImmersedGrains

@@ -5,6 +5,8 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/particles/particle_handler.h>
 
+#include <immersed_grains/box_buckets.h>
+
 #include <array>
 #include <string>
 #include <vector>
@@ -177,10 +179,8 @@ namespace ImmersedGrains
     /// The coarse cells (level 0) in the box's lexicographic order; for a
     /// Gmsh mesh in the triangulation's order, with their bounding boxes.
     std::vector<typename dealii::Triangulation<dim>::cell_iterator> coarse;
-    std::vector<dealii::BoundingBox<dim>>  coarse_boxes;
-    std::vector<std::vector<unsigned int>> coarse_in_bucket;
-    std::array<unsigned int, dim>          n_buckets;
-    double                                 bucket_size = 1;
+    std::vector<dealii::BoundingBox<dim>> coarse_boxes;
+    BoxBuckets<dim>                       coarse_buckets;
   };
 } // namespace ImmersedGrains
 
