@@ -1176,6 +1176,14 @@ namespace ImmersedGrains
   }
 
 
+  template <int dim>
+  void
+  Grains<dim>::set_removed(const unsigned long n)
+  {
+    removed_total = n;
+  }
+
+
   template GrainPropertyLayout
   make_grain_property_layout(const GrainParameters<2> &, bool, bool);
   template GrainPropertyLayout

@@ -225,6 +225,8 @@ namespace ImmersedGrains
     }
     out << "run_figures " << std::hexfloat << previous_step << ' '
         << retries_taken << ' ' << breakup_time << '\n';
+    out << "grains_removed " << std::hexfloat
+        << static_cast<double>(grains ? grains->n_removed() : 0) << '\n';
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
@@ -312,7 +314,13 @@ namespace ImmersedGrains
         books.imbalance[d] = exchange.empty() ? 0 : exchange[1 + d];
     }
     const auto figures = optional_line("run_figures", 3);
+    // Absent before grains could leave through a mesh's open boundary
+    // counted so: the restored row holds the count.
+    const auto removed = optional_line("grains_removed", 1);
     statistics.load_values(in);
+    if (grains)
+      grains->set_removed(static_cast<unsigned long>(
+        removed.empty() ? statistics.get("grains_removed") : removed[0]));
     // Absent before run_figures: the restored row holds them.
     previous_step = figures.empty() ? statistics.get("dt") : figures[0];
     retries_taken =

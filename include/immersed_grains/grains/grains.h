@@ -330,8 +330,13 @@ namespace ImmersedGrains
     std::vector<ContactForce>
     contact_forces() const;
 
+    /** The grains that left through open boundaries since the start. */
     unsigned long
     n_removed() const;
+
+    /** Sets that count (a resumed run's). */
+    void
+    set_removed(unsigned long n);
 
     double
     mass(double radius) const;
