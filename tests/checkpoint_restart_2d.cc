@@ -228,22 +228,7 @@ main(int argc, char **argv)
     [one_rank](const std::vector<std::vector<std::string>> &straight,
                const std::vector<std::vector<std::string>> &resumed)
   {
-    double       largest = 0;
-    unsigned int wall    = 0;
-    for (unsigned int c = 0; c < straight[0].size(); ++c)
-      if (straight[0][c] == "wall_time")
-        wall = c;
-    for (unsigned int r = 1; r < std::min(straight.size(), resumed.size()); ++r)
-      for (unsigned int c = 0; c < straight[r].size(); ++c)
-        if (c != wall)
-        {
-          const double a = std::stod(straight[r][c]);
-          const double b = std::stod(resumed[r][c]);
-          if (a != b)
-            largest =
-              std::max(largest,
-                       std::abs(a - b) / std::max(std::abs(a), std::abs(b)));
-        }
+    const double largest = largest_statistics_difference(straight, resumed);
     std::cout << "same rows, same steps: "
               << (straight.size() == resumed.size() &&
                       straight.back()[0] == resumed.back()[0] ?

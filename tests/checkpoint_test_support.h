@@ -13,6 +13,8 @@
 #include <immersed_grains/parameters.h>
 #include <immersed_grains/simulation.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -78,6 +80,33 @@ run_2d_scene(const std::string &file,
   ImmersedGrains::parse_parameter_file(prm, file);
   ImmersedGrains::Simulation<2> simulation(prm, file, comm);
   simulation.run();
+}
+
+// The largest relative difference between two runs' statistics rows (as
+// read_csv_rows() gives them, header first), over every column but
+// wall_time and the rows both have.
+inline double
+largest_statistics_difference(
+  const std::vector<std::vector<std::string>> &straight,
+  const std::vector<std::vector<std::string>> &resumed)
+{
+  double       largest = 0;
+  unsigned int wall    = 0;
+  for (unsigned int c = 0; c < straight[0].size(); ++c)
+    if (straight[0][c] == "wall_time")
+      wall = c;
+  for (unsigned int r = 1; r < std::min(straight.size(), resumed.size()); ++r)
+    for (unsigned int c = 0; c < straight[r].size(); ++c)
+      if (c != wall)
+      {
+        const double a = std::stod(straight[r][c]);
+        const double b = std::stod(resumed[r][c]);
+        if (a != b)
+          largest =
+            std::max(largest,
+                     std::abs(a - b) / std::max(std::abs(a), std::abs(b)));
+      }
+  return largest;
 }
 
 // The fields of every line of a CSV file (statistics.csv), header first.

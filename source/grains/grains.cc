@@ -1,5 +1,4 @@
 #include <deal.II/base/utilities.h>
-#include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/filtered_iterator.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/numerics/rtree.h>

@@ -9,7 +9,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
-#include <deal.II/fe/mapping_cartesian.h>
+#include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_block_sparse_matrix.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
@@ -315,11 +315,6 @@ namespace ImmersedGrains
 
     dealii::FESystem<dim>   fe;
     dealii::DoFHandler<dim> dof_handler;
-    // Every mesh is a subdivided box, refined: its cells are axis-parallel,
-    // and the Cartesian map is exact for them at a fraction of MappingQ1's
-    // cost (constant Jacobians, a closed-form inverse; MappingQ1 also
-    // rebuilt its support points for every FEValues object,
-    // doc/performance.md).
     // Geometry::mapping(): the Cartesian map on meshes of axis-parallel
     // cells (MappingQ1 rebuilt its support points for every FEValues
     // object, doc/performance.md), MappingQ1 on others.

@@ -4,7 +4,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/tria.h>
-#include <deal.II/fe/mapping_cartesian.h>
+#include <deal.II/fe/mapping.h>
 #include <deal.II/grid/grid_tools_cache.h>
 #include <deal.II/numerics/data_component_interpretation.h>
 #include <deal.II/particles/particle_handler.h>
