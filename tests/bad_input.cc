@@ -396,6 +396,17 @@ end
      "set Dimension = 2\nsubsection Output\n set Boundary forces = 7\nend\n",
      "Boundary forces",
      "boundary id 7"},
+    {"boundary_flux_unknown_id",
+     "set Dimension = 2\nsubsection Output\n set Boundary fluxes = 0, "
+     "5\nend\n",
+     "Boundary fluxes",
+     "boundary id 5"},
+    {"boundary_flux_without_fluid",
+     "set Dimension = 2\nsubsection Output\n set Boundary fluxes = "
+     "0\nend\n" +
+       dry_grain,
+     "Boundary fluxes",
+     "needs the fluid"},
     {"probe_outside",
      "set Dimension = 2\nsubsection Output\n set Probes = far: 2, 2\nend\n",
      "Probes",

@@ -205,8 +205,8 @@ namespace ImmersedGrains
     static std::vector<std::string>
     statistics_columns();
 
-    // Output/Boundary forces and Output/Probes: reads them and adds their
-    // columns.
+    // Output/Boundary forces, Output/Boundary fluxes and Output/Probes:
+    // reads them and adds their columns.
     void
     parse_output_points(dealii::ParameterHandler &prm,
                         const InputLocation      &where);
@@ -282,9 +282,12 @@ namespace ImmersedGrains
     unsigned int                    test_every = 1;
     std::vector<TestCheck>          test_checks;
     std::vector<dealii::Point<dim>> pressure_drop_points;
-    /** Output/Boundary forces and Output/Probes, with their columns. */
+    /** Output/Boundary forces, Boundary fluxes and Probes, with their
+     * columns. */
     std::vector<dealii::types::boundary_id>                 boundary_force_ids;
     std::string                                             boundary_force_text;
+    std::vector<dealii::types::boundary_id>                 boundary_flux_ids;
+    std::string                                             boundary_flux_text;
     std::vector<std::pair<std::string, dealii::Point<dim>>> probes;
     std::string                                             probe_text;
     std::string                                             pressure_drop_text;

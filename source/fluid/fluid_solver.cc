@@ -347,55 +347,96 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  dealii::Tensor<1, dim>
-  FluidSolver<dim>::boundary_force(const dealii::types::boundary_id id) const
+  void
+  FluidSolver<dim>::integrate_over_boundary(
+    const dealii::types::boundary_id                       id,
+    const dealii::UpdateFlags                              flags,
+    const std::function<void(const dealii::FEFaceValues<dim> &,
+                             const MixtureValues<dim> &)> &add_face) const
   {
     const dealii::QGauss<dim - 1> face_quadrature(fe.degree + 1);
     dealii::FEFaceValues<dim>     fe_face_values(
       mapping,
       fe,
       face_quadrature,
-      dealii::update_values | dealii::update_gradients |
-        dealii::update_normal_vectors | dealii::update_JxW_values |
+      flags | dealii::update_normal_vectors | dealii::update_JxW_values |
         dealii::update_quadrature_points);
-    const dealii::FEValuesExtractors::Vector velocities(0);
-    const dealii::FEValuesExtractors::Scalar pressure(dim);
-    const unsigned int                       n_q = face_quadrature.size();
-    std::vector<dealii::Tensor<2, dim>>      grad_u(n_q);
-    std::vector<double>                      p(n_q);
-    std::vector<dealii::Point<dim>>          reference(n_q);
-    MixtureValues<dim>                       mixture;
-    const double                             mu = parameters.viscosity;
-    dealii::Tensor<1, dim>                   force;
+    std::vector<dealii::Point<dim>> reference(face_quadrature.size());
+    MixtureValues<dim>              mixture;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned() && cell->at_boundary())
         for (const unsigned int f : cell->face_indices())
           if (cell->at_boundary(f) && cell->face(f)->boundary_id() == id)
           {
             fe_face_values.reinit(cell, f);
-            fe_face_values[velocities].get_function_gradients(solution, grad_u);
-            fe_face_values[pressure].get_function_values(solution, p);
             // The face's points in the cell's reference coordinates, for
             // the fluid fraction there.
             const auto on_face = dealii::QProjector<dim>::project_to_face(
               dealii::ReferenceCells::get_hypercube<dim>(), face_quadrature, f);
-            for (unsigned int q = 0; q < n_q; ++q)
+            for (unsigned int q = 0; q < reference.size(); ++q)
               reference[q] = on_face.point(q);
             mixture_fields->evaluate(cell,
                                      fe_face_values.get_quadrature_points(),
                                      reference,
                                      time,
                                      mixture);
-            for (unsigned int q = 0; q < n_q; ++q)
-            {
-              const auto &n     = fe_face_values.normal_vector(q);
-              const auto stress = -p[q] * dealii::unit_symmetric_tensor<dim>() +
-                                  mu * (grad_u[q] + transpose(grad_u[q]));
-              force -= mixture.fluid_fraction[q] * (stress * n) *
-                       fe_face_values.JxW(q);
-            }
+            add_face(fe_face_values, mixture);
           }
+  }
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  FluidSolver<dim>::boundary_force(const dealii::types::boundary_id id) const
+  {
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    const dealii::FEValuesExtractors::Scalar pressure(dim);
+    const double                             mu = parameters.viscosity;
+    std::vector<dealii::Tensor<2, dim>>      grad_u;
+    std::vector<double>                      p;
+    dealii::Tensor<1, dim>                   force;
+    integrate_over_boundary(
+      id,
+      dealii::update_values | dealii::update_gradients,
+      [&](const dealii::FEFaceValues<dim> &values,
+          const MixtureValues<dim>        &mixture)
+      {
+        grad_u.resize(values.n_quadrature_points);
+        p.resize(values.n_quadrature_points);
+        values[velocities].get_function_gradients(solution, grad_u);
+        values[pressure].get_function_values(solution, p);
+        for (unsigned int q = 0; q < values.n_quadrature_points; ++q)
+        {
+          const auto stress = -p[q] * dealii::unit_symmetric_tensor<dim>() +
+                              mu * (grad_u[q] + transpose(grad_u[q]));
+          force -= mixture.fluid_fraction[q] *
+                   (stress * values.normal_vector(q)) * values.JxW(q);
+        }
+      });
     return dealii::Utilities::MPI::sum(force, mpi_communicator);
+  }
+
+
+  template <int dim>
+  double
+  FluidSolver<dim>::boundary_flux(const dealii::types::boundary_id id) const
+  {
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    std::vector<dealii::Tensor<1, dim>>      u;
+    double                                   flux = 0;
+    integrate_over_boundary(
+      id,
+      dealii::update_values,
+      [&](const dealii::FEFaceValues<dim> &values,
+          const MixtureValues<dim>        &mixture)
+      {
+        u.resize(values.n_quadrature_points);
+        values[velocities].get_function_values(solution, u);
+        for (unsigned int q = 0; q < values.n_quadrature_points; ++q)
+          flux += mixture.fluid_fraction[q] * (u[q] * values.normal_vector(q)) *
+                  values.JxW(q);
+      });
+    return dealii::Utilities::MPI::sum(flux, mpi_communicator);
   }
 
 

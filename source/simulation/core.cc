@@ -14,6 +14,8 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 namespace ImmersedGrains
 {
@@ -151,6 +153,14 @@ namespace ImmersedGrains
         "+ grad u^T) with p the pressure without its hydrostatic part, n "
         "the fluid's outward normal.");
       prm.declare_entry(
+        "Boundary fluxes",
+        "",
+        Anything(),
+        "Boundary ids (comma list) whose fluid volume flux is recorded: "
+        "columns boundary_flux_<id>, the integral of phi u.n over those "
+        "faces [m^3/s; m^2/s in 2D], n the outward normal (negative "
+        "through an inflow).");
+      prm.declare_entry(
         "Probes",
         "",
         Anything(),
@@ -268,12 +278,19 @@ namespace ImmersedGrains
                                             "Pressure drop points",
                                             pressure_drop_text,
                                             "a point lies outside the mesh");
-    for (const auto id : boundary_force_ids)
-      InputLocation{file, "Output"}.require(
-        geometry.boundary_types.count(id) == 1,
-        "Boundary forces",
-        boundary_force_text,
-        "boundary id " + std::to_string(id) + " is not on the mesh");
+    const std::tuple<const char *,
+                     const std::vector<dealii::types::boundary_id> *,
+                     const std::string *>
+      boundary_outputs[] = {
+        {"Boundary forces", &boundary_force_ids, &boundary_force_text},
+        {"Boundary fluxes", &boundary_flux_ids, &boundary_flux_text}};
+    for (const auto &[name, ids, text] : boundary_outputs)
+      for (const auto id : *ids)
+        InputLocation{file, "Output"}.require(
+          geometry.boundary_types.count(id) == 1,
+          name,
+          *text,
+          "boundary id " + std::to_string(id) + " is not on the mesh");
     for (const auto &[name, point] : probes)
       InputLocation{file, "Output"}.require(geometry.contains(point),
                                             "Probes",
@@ -281,12 +298,16 @@ namespace ImmersedGrains
                                             "probe '" + name +
                                               "' lies outside the mesh");
     fluid_parameters.parse_parameters(prm, file, geometry);
-    InputLocation{file, "Output"}.require(
-      fluid_parameters.enabled ||
-        (boundary_force_ids.empty() && probes.empty()),
-      boundary_force_ids.empty() ? "Probes" : "Boundary forces",
-      boundary_force_ids.empty() ? probe_text : boundary_force_text,
-      "needs the fluid (Fluid/Enabled = true)");
+    // Each of these outputs is a field of the fluid's.
+    for (const auto &[name, text] :
+         {std::pair{"Boundary forces", &boundary_force_text},
+          std::pair{"Boundary fluxes", &boundary_flux_text},
+          std::pair{"Probes", &probe_text}})
+      InputLocation{file, "Output"}.require(
+        fluid_parameters.enabled || dealii::Utilities::trim(*text).empty(),
+        name,
+        *text,
+        "needs the fluid (Fluid/Enabled = true)");
     grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);

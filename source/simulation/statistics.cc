@@ -109,20 +109,29 @@ namespace ImmersedGrains
   {
     static const char *const axes[] = {"_x", "_y", "_z"};
     std::vector<std::string> columns;
-    boundary_force_text = prm.get("Boundary forces");
-    for (const double id :
-         parse_double_list(boundary_force_text, where, "Boundary forces"))
+    // Boundary ids, a comma list of whole numbers.
+    const auto parse_ids = [&](const std::string &name, std::string &text)
     {
-      where.require(id >= 0 && id == std::floor(id) &&
-                      id < dealii::numbers::internal_face_boundary_id,
-                    "Boundary forces",
-                    boundary_force_text,
-                    "boundary ids are whole numbers from 0");
-      boundary_force_ids.push_back(static_cast<dealii::types::boundary_id>(id));
+      text = prm.get(name);
+      std::vector<dealii::types::boundary_id> ids;
+      for (const double id : parse_double_list(text, where, name))
+      {
+        where.require(id >= 0 && id == std::floor(id) &&
+                        id < dealii::numbers::internal_face_boundary_id,
+                      name,
+                      text,
+                      "boundary ids are whole numbers from 0");
+        ids.push_back(static_cast<dealii::types::boundary_id>(id));
+      }
+      return ids;
+    };
+    boundary_force_ids = parse_ids("Boundary forces", boundary_force_text);
+    for (const auto id : boundary_force_ids)
       for (unsigned int d = 0; d < dim; ++d)
-        columns.push_back("boundary_force_" +
-                          std::to_string(boundary_force_ids.back()) + axes[d]);
-    }
+        columns.push_back("boundary_force_" + std::to_string(id) + axes[d]);
+    boundary_flux_ids = parse_ids("Boundary fluxes", boundary_flux_text);
+    for (const auto id : boundary_flux_ids)
+      columns.push_back("boundary_flux_" + std::to_string(id));
     probe_text = prm.get("Probes");
     for (const std::string &entry :
          dealii::Utilities::split_string_list(probe_text, ';'))
@@ -227,6 +236,9 @@ namespace ImmersedGrains
         statistics.set("boundary_force_" + std::to_string(id) + axes[d],
                        force[d]);
     }
+    for (const auto id : boundary_flux_ids)
+      statistics.set("boundary_flux_" + std::to_string(id),
+                     fluid->boundary_flux(id));
     for (const auto &[name, point] : probes)
     {
       statistics.set("probe_" + name + "_pressure", fluid->pressure_at(point));

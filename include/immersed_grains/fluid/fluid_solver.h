@@ -9,6 +9,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_block_sparse_matrix.h>
@@ -20,6 +21,7 @@
 #include <immersed_grains/mesh/cell_point_shapes.h>
 #include <immersed_grains/mesh/geometry.h>
 
+#include <functional>
 #include <memory>
 #include <stdexcept>
 
@@ -200,6 +202,14 @@ namespace ImmersedGrains
     dealii::Tensor<1, dim>
     boundary_force(dealii::types::boundary_id id) const;
 
+    /**
+     * The fluid's volume flux out through the boundary parts with id @p id
+     * (m^3/s; m^2/s in 2D): the integral of phi u.n, n the outward normal,
+     * so negative through an inflow. Collective.
+     */
+    double
+    boundary_flux(dealii::types::boundary_id id) const;
+
     /** The largest velocity component at a node (collective). */
     double
     max_velocity() const;
@@ -239,6 +249,16 @@ namespace ImmersedGrains
     get_time() const;
 
   private:
+    // Calls @p add_face for each face with boundary id @p id that this
+    // rank owns, with the fluid fraction at its quadrature points; the
+    // FEFaceValues have @p flags and the normals, JxW and points.
+    void
+    integrate_over_boundary(
+      dealii::types::boundary_id                             id,
+      dealii::UpdateFlags                                    flags,
+      const std::function<void(const dealii::FEFaceValues<dim> &,
+                               const MixtureValues<dim> &)> &add_face) const;
+
     // solve_time_step() without the way back.
     StepStatistics
     advance(double new_time, double dt);
