@@ -230,8 +230,10 @@ namespace ImmersedGrains
     if (!parameters.two_way)
       return;
     // The simulation owns both; the fluid only borrows this object.
+    // Grains meet inflow faces as walls: no solid flux passes there.
     fluid.set_mixture_fields(std::shared_ptr<const MixtureFields<dim>>(
-      this, [](const MixtureFields<dim> *) {}));
+                               this, [](const MixtureFields<dim> *) {}),
+                             false);
     if (!drag_as_field())
       fluid.set_point_drag_source(std::shared_ptr<const PointDragSource<dim>>(
                                     this, [](const PointDragSource<dim> *) {}),

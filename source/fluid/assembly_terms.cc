@@ -359,8 +359,10 @@ namespace ImmersedGrains
     const Geometry<dim>         &geometry,
     const MixtureFields<dim>    &mixture_fields,
     dealii::Function<dim>       &open_pressure,
-    const double                 time)
+    const double                 time,
+    const bool                   solid_crosses_inflow)
       : geometry(geometry)
+      , solid_crosses_inflow(solid_crosses_inflow)
       , mixture_fields(mixture_fields)
       , open_pressure(open_pressure)
       , time(time)
@@ -384,10 +386,12 @@ namespace ImmersedGrains
 
   template <int dim>
   bool
-  BoundaryFluxTerm<dim>::needed(const Geometry<dim> &geometry)
+  BoundaryFluxTerm<dim>::needed(const Geometry<dim> &geometry,
+                                const bool           solid_crosses_inflow)
   {
     for (const auto &[id, type] : geometry.boundary_types)
-      if (type == BoundaryType::open || type == BoundaryType::velocity)
+      if (type == BoundaryType::open ||
+          (type == BoundaryType::velocity && solid_crosses_inflow))
         return true;
     return false;
   }
@@ -405,7 +409,8 @@ namespace ImmersedGrains
       if (!face->at_boundary())
         continue;
       const BoundaryType type = geometry.boundary_type(face->boundary_id());
-      if (type != BoundaryType::open && type != BoundaryType::velocity)
+      if (type != BoundaryType::open &&
+          !(type == BoundaryType::velocity && solid_crosses_inflow))
         continue;
       fe_face_values.reinit(cell, face_no);
       mixture_fields.evaluate(cell,

@@ -570,7 +570,10 @@ namespace ImmersedGrains
    *       + (phi rho (grad u) u, v) + (phi mu grad u, grad v)
    *       - (p, div(phi v)) + (beta (u - u_p), v) - (f, v)
    *       + <phi p_open, v.n>_open
-   *   R_p = -(q, div(phi u) - g) + (grad q, s) - <q, s.n>_{open, velocity},
+   *   R_p = -(q, div(phi u) - g) + (grad q, s) - <q, s.n>_out,
+   *
+   * "out" the open faces, and the velocity faces where the solid crosses
+   * them (prescribed fields; grains meet them as walls),
    *
    * one AssemblyTerm per term (assembly_terms.h), listed for the scene by
    * make_assembly_terms(): a term the scene switches off is not visited.
@@ -844,7 +847,7 @@ namespace ImmersedGrains
       add(std::make_unique<GrainDragTerm<dim>>(
             *point_drag_source, fe, dofs, cell_averaged_drag, max_beta),
           false);
-    if (BoundaryFluxTerm<dim>::needed(geometry))
+    if (BoundaryFluxTerm<dim>::needed(geometry, solid_crosses_inflow))
       add(std::make_unique<BoundaryFluxTerm<dim>>(
             mapping,
             fe,
@@ -852,7 +855,8 @@ namespace ImmersedGrains
             geometry,
             *mixture_fields,
             *parameters.open_boundary_pressure,
-            time),
+            time,
+            solid_crosses_inflow),
           false);
     return list;
   }

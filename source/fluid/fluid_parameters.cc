@@ -102,6 +102,16 @@ namespace ImmersedGrains
         "expression per component separated by ';', each a function of x, "
         "y[, z] and t (deal.II FunctionParser), e.g. '0; 6*x*(1-x)'. Empty: "
         "the subsection Boundary velocity gives it (zero by default).");
+      prm.declare_entry(
+        "Superficial inflow",
+        "false",
+        Bool(),
+        "false: the Inflow velocity is the fluid's own (interstitial) "
+        "velocity u at the boundary; true: it is the superficial velocity "
+        "phi u, the flow rate per unit area that a pump and a distributor "
+        "plate fix, so the fluid enters at u = U/phi where grains on or "
+        "near the boundary lower phi (a fluidized bed resting on its "
+        "inflow).");
       prm.declare_entry("Density",
                         "1000",
                         Double(),
@@ -338,9 +348,10 @@ namespace ImmersedGrains
     const InputLocation where{file, "Fluid"};
     prm.enter_subsection("Fluid");
     {
-      enabled   = prm.get_bool("Enabled");
-      density   = prm.get_double("Density");
-      viscosity = prm.get_double("Viscosity");
+      enabled            = prm.get_bool("Enabled");
+      superficial_inflow = prm.get_bool("Superficial inflow");
+      density            = prm.get_double("Density");
+      viscosity          = prm.get_double("Viscosity");
       where.require(density > 0,
                     "Density",
                     prm.get("Density"),

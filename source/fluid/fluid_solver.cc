@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <set>
 #include <sstream>
 
 #include <deal.II/base/qprojector.h>
@@ -229,10 +230,12 @@ namespace ImmersedGrains
   template <int dim>
   void
   FluidSolver<dim>::set_mixture_fields(
-    std::shared_ptr<const MixtureFields<dim>> fields)
+    std::shared_ptr<const MixtureFields<dim>> fields,
+    const bool                                solid_crosses_inflow)
   {
-    mixture_fields    = fields;
-    fields_prescribed = false;
+    mixture_fields             = fields;
+    fields_prescribed          = false;
+    this->solid_crosses_inflow = solid_crosses_inflow;
   }
 
 
@@ -639,6 +642,8 @@ namespace ImmersedGrains
             c,
             velocity_mask);
       }
+      if (!homogeneous && parameters.superficial_inflow)
+        divide_inflow_by_fluid_fraction(c);
       if (!slip_faces.empty())
         dealii::VectorTools::compute_no_normal_flux_constraints(
           dof_handler, 0, slip_faces, c, mapping);
@@ -660,6 +665,60 @@ namespace ImmersedGrains
         dealii::DoFTools::make_periodicity_constraints(
           dof_handler, 2 * d, 2 * d + 1, d, pressure_mass_constraints);
     pressure_mass_constraints.close();
+  }
+
+
+  template <int dim>
+  void
+  FluidSolver<dim>::divide_inflow_by_fluid_fraction(
+    dealii::AffineConstraints<double> &constraints) const
+  {
+    const auto inflow_ids = geometry.boundary_ids(BoundaryType::velocity);
+    const std::vector<dealii::Point<dim>> &unit_points =
+      fe.get_unit_support_points();
+    std::vector<dealii::types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    std::vector<unsigned int>                    on_face;
+    std::vector<dealii::Point<dim>>              points, reference;
+    MixtureValues<dim>                           mixture;
+    std::set<dealii::types::global_dof_index>    divided;
+    // Every cell whose DoFs this rank constrains, ghosts included, so that
+    // the ranks sharing a DoF divide it by the same (continuous) phi.
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial() && cell->at_boundary())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) &&
+              std::find(inflow_ids.begin(),
+                        inflow_ids.end(),
+                        cell->face(f)->boundary_id()) != inflow_ids.end())
+          {
+            cell->get_dof_indices(dofs);
+            on_face.clear();
+            points.clear();
+            reference.clear();
+            for (unsigned int i = 0; i < dofs.size(); ++i)
+              if (fe.system_to_component_index(i).first < dim &&
+                  fe.has_support_on_face(i, f) &&
+                  constraints.is_inhomogeneously_constrained(dofs[i]) &&
+                  constraints.get_constraint_entries(dofs[i])->empty() &&
+                  divided.count(dofs[i]) == 0)
+              {
+                on_face.push_back(i);
+                reference.push_back(unit_points[i]);
+                points.push_back(
+                  mapping.transform_unit_to_real_cell(cell, unit_points[i]));
+              }
+            if (on_face.empty())
+              continue;
+            mixture_fields->evaluate(cell, points, reference, time, mixture);
+            for (unsigned int k = 0; k < on_face.size(); ++k)
+            {
+              const auto dof = dofs[on_face[k]];
+              constraints.set_inhomogeneity(dof,
+                                            constraints.get_inhomogeneity(dof) /
+                                              mixture.fluid_fraction[k]);
+              divided.insert(dof);
+            }
+          }
   }
 
 

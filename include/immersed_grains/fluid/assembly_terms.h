@@ -317,8 +317,10 @@ namespace ImmersedGrains
 
 
   /**
-   * Open faces: the weakly imposed pressure <phi p_open, v.n>. Open and
-   * velocity faces: the solid flux that leaves, -<q, s.n>.
+   * Open faces: the weakly imposed pressure <phi p_open, v.n>, and the
+   * solid flux that leaves, -<q, s.n>. Velocity faces: that flux too where
+   * the solid crosses them (prescribed mixture fields); grains meet them as
+   * walls, so with grains no solid flux passes there.
    */
   template <int dim>
   class BoundaryFluxTerm : public AssemblyTerm<dim>
@@ -330,16 +332,19 @@ namespace ImmersedGrains
                      const Geometry<dim>         &geometry,
                      const MixtureFields<dim>    &mixture_fields,
                      dealii::Function<dim>       &open_pressure,
-                     double                       time);
+                     double                       time,
+                     bool                         solid_crosses_inflow);
     void
     cell(const CellContext<dim> &, CellIntegrals &) const override;
 
-    /** Whether any face of the geometry is open or carries a velocity. */
+    /** Whether any face of the geometry is open, or carries a velocity
+     * that the solid crosses. */
     static bool
-    needed(const Geometry<dim> &geometry);
+    needed(const Geometry<dim> &geometry, bool solid_crosses_inflow);
 
   private:
     const Geometry<dim>                         &geometry;
+    const bool                                   solid_crosses_inflow;
     const MixtureFields<dim>                    &mixture_fields;
     dealii::Function<dim>                       &open_pressure;
     const double                                 time;

@@ -104,6 +104,8 @@ namespace ImmersedGrains
     // Whether the forcing's expression is a constant (numbers only).
     bool forcing_is_constant = false;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> boundary_velocity;
+    // The boundary velocity on inflow faces is phi u, not u.
+    bool superficial_inflow = false;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>>
       open_boundary_pressure;
     std::shared_ptr<dealii::Functions::ParsedFunction<dim>> initial_velocity;

@@ -115,8 +115,11 @@ namespace ImmersedGrains
     void
     load_state(std::istream &in);
 
+    /** @p solid_crosses_inflow: whether the solid flux of @p fields
+     * passes through inflow (velocity) faces; grains meet them as walls. */
     void
-    set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields);
+    set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields,
+                       bool solid_crosses_inflow = true);
 
     /**
      * Grains' implicit drag (none by default): at each grain's centre
@@ -259,6 +262,12 @@ namespace ImmersedGrains
       const std::function<void(const dealii::FEFaceValues<dim> &,
                                const MixtureValues<dim> &)> &add_face) const;
 
+    // Fluid/Superficial inflow: the prescribed values on inflow faces in
+    // @p constraints (not yet closed) become u = U/phi.
+    void
+    divide_inflow_by_fluid_fraction(
+      dealii::AffineConstraints<double> &constraints) const;
+
     // solve_time_step() without the way back.
     StepStatistics
     advance(double new_time, double dt);
@@ -392,6 +401,9 @@ namespace ImmersedGrains
     double max_open_pressure          = 0; // |p| on open faces, Pa
     // Whether the mixture fields are the prescribed functions, not grains'.
     bool fields_prescribed = true;
+    // Whether the mixture's solid flux passes through inflow faces
+    // (set_mixture_fields()).
+    bool solid_crosses_inflow = true;
 
     // Samples the open-face pressure at the faces' vertices.
     void
