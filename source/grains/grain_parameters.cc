@@ -3,6 +3,7 @@
 #include <immersed_grains/grains/grain_parameters.h>
 
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 namespace ImmersedGrains
@@ -110,7 +111,8 @@ namespace ImmersedGrains
                           Anything(),
                           "Shape = file: one grain per line, 'x y [z] [r "
                           "[vx vy [vz]]]' separated by spaces or commas; "
-                          "'#' starts a comment.");
+                          "'#' starts a comment. A relative path is read "
+                          "from the folder of the parameter file.");
       }
       prm.leave_subsection();
     }
@@ -397,6 +399,12 @@ namespace ImmersedGrains
           parse_point_list<dim>(velocities_text, place, "Velocities");
         random_seed    = prm.get_integer("Random seed");
         placement_file = prm.get("File");
+        {
+          std::filesystem::path path(placement_file);
+          if (path.is_relative())
+            path = std::filesystem::path(file).parent_path() / path;
+          placement_path = path.lexically_normal().string();
+        }
         if (enabled && shape == PlacementShape::list)
           place.require(!positions.empty(),
                         "Positions",

@@ -410,7 +410,7 @@ namespace ImmersedGrains
     read_file(const GrainParameters<dim> &prm)
     {
       const InputLocation where{prm.file, "Grains/Placement"};
-      std::ifstream       in(prm.placement_file);
+      std::ifstream       in(prm.placement_path);
       where.require(bool(in), "File", prm.placement_file, "cannot open it");
       std::vector<GrainSeed<dim>> grains;
       unsigned int                line_number = 0;

@@ -80,6 +80,8 @@ namespace ImmersedGrains
     std::vector<dealii::Point<dim>> velocities; // as points: one per grain
     unsigned int                    random_seed = 1;
     std::string                     placement_file;
+    // placement_file read from the parameter file's folder if relative.
+    std::string placement_path;
     // The entry texts, for messages naming them.
     std::string size_text, solid_fraction_text, count_text, positions_text,
       velocities_text, center_text;
