@@ -31,34 +31,12 @@ base = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                     "boycott_2d_%g" % angle)
 
 
-def node(i, j):
-    return 1 + i + (nx + 1) * j
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import structured_2d  # noqa: E402
 
-
-elements = []
-for i in range(nx):
-    elements.append((1, 1, [node(i, 0), node(i + 1, 0)]))
-    elements.append((1, 1, [node(i, ny), node(i + 1, ny)]))
-for j in range(ny):
-    elements.append((1, 1, [node(0, j), node(0, j + 1)]))
-    elements.append((1, 1, [node(nx, j), node(nx, j + 1)]))
-for j in range(ny):
-    for i in range(nx):
-        elements.append((3, 10, [node(i, j), node(i + 1, j),
-                                 node(i + 1, j + 1), node(i, j + 1)]))
 with open(base + ".msh", "w") as out:
-    out.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n")
-    out.write(f"{(nx + 1) * (ny + 1)}\n")
-    for j in range(ny + 1):
-        y = j * H / ny
-        for i in range(nx + 1):
-            out.write(f"{node(i, j)} {i * W / nx + y * shift:.10g} "
-                      f"{y:.10g} 0\n")
-    out.write(f"$EndNodes\n$Elements\n{len(elements)}\n")
-    for number, (kind, tag, nodes) in enumerate(elements, 1):
-        out.write(f"{number} {kind} 2 {tag} {tag} "
-                  + " ".join(map(str, nodes)) + "\n")
-    out.write("$EndElements\n")
+    structured_2d.write(out, nx, ny, lambda i, j: (
+        i * W / nx + j * H / ny * shift, j * H / ny))
 
 # The suspension: centres at least 1.01 r from the walls (measured across
 # the leaning walls) and 2.02 r apart, on a bucket grid of 2.02 r.
