@@ -74,10 +74,8 @@ main(int argc, char **argv)
     const auto resumed  = read_csv_rows("resumed/statistics.csv");
     std::cout << "rows: " << straight.size() << " straight, " << resumed.size()
               << " resumed\n";
-    unsigned int removed_column = 0;
-    for (unsigned int c = 0; c < straight[0].size(); ++c)
-      if (straight[0][c] == "grains_removed")
-        removed_column = c;
+    const unsigned int removed_column =
+      column_index(straight, "grains_removed");
     std::cout << "statistics equal exactly (wall_time aside): "
               << (largest_statistics_difference(straight, resumed) == 0 ?
                     "yes" :

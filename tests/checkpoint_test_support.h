@@ -1,8 +1,9 @@
-// What the checkpoint tests (checkpoint_restart_2d, checkpoint_killed_2d)
-// share. Their scene: 81 discs (r = 12.5 um, 2400 kg/m^3) in a ball of
-// 0.25 mm in glycerine, a 2 mm box, an adaptive mesh (levels 2-4, adapted
-// every 3 steps) and contacts: every kind of state a checkpoint holds.
-// Each test adds End time, the output directory and its Checkpoint
+// What the tests that run whole scenes from a parameter text share (the
+// checkpoint tests, adaptive_band_outrun_2d, fluidized_bed_3d). The
+// checkpoint tests' scene: 81 discs (r = 12.5 um, 2400 kg/m^3) in a ball
+// of 0.25 mm in glycerine, a 2 mm box, an adaptive mesh (levels 2-4,
+// adapted every 3 steps) and contacts: every kind of state a checkpoint
+// holds. Each test adds End time, the output directory and its Checkpoint
 // subsection.
 #ifndef immersed_grains_tests_checkpoint_test_support_h
 #define immersed_grains_tests_checkpoint_test_support_h
@@ -62,13 +63,14 @@ subsection Output
 end
 )";
 
-// Writes @p text to @p file (rank 0 of MPI_COMM_WORLD) and runs it as a 2D
-// scene on @p comm; the ranks outside @p comm (MPI_COMM_NULL) only wait
-// for the file.
+// Writes @p text to @p file (rank 0 of MPI_COMM_WORLD) and runs it as a
+// scene of dimension @p dim on @p comm; the ranks outside @p comm
+// (MPI_COMM_NULL) only wait for the file.
+template <int dim>
 inline void
-run_2d_scene(const std::string &file,
-             const std::string &text,
-             MPI_Comm           comm = MPI_COMM_WORLD)
+run_scene(const std::string &file,
+          const std::string &text,
+          MPI_Comm           comm = MPI_COMM_WORLD)
 {
   if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
     std::ofstream(file) << text;
@@ -76,10 +78,18 @@ run_2d_scene(const std::string &file,
   if (comm == MPI_COMM_NULL)
     return;
   dealii::ParameterHandler prm;
-  ImmersedGrains::Simulation<2>::declare_parameters(prm);
+  ImmersedGrains::Simulation<dim>::declare_parameters(prm);
   ImmersedGrains::parse_parameter_file(prm, file);
-  ImmersedGrains::Simulation<2> simulation(prm, file, comm);
+  ImmersedGrains::Simulation<dim> simulation(prm, file, comm);
   simulation.run();
+}
+
+inline void
+run_2d_scene(const std::string &file,
+             const std::string &text,
+             MPI_Comm           comm = MPI_COMM_WORLD)
+{
+  run_scene<2>(file, text, comm);
 }
 
 // The largest relative difference between two runs' statistics rows (as
@@ -126,6 +136,16 @@ read_csv_rows(const std::string &file)
     rows.push_back(fields);
   }
   return rows;
+}
+
+// The index of the column @p name in statistics rows (header first).
+inline unsigned int
+column_index(const std::vector<std::vector<std::string>> &rows,
+             const std::string                           &name)
+{
+  const auto at = std::find(rows[0].begin(), rows[0].end(), name);
+  AssertThrow(at != rows[0].end(), dealii::ExcMessage("no column " + name));
+  return at - rows[0].begin();
 }
 
 #endif

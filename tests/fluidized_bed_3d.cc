@@ -100,28 +100,7 @@ subsection Output
   set Pressure drop points = 0.003, 0.003, 0; 0.003, 0.003, 0.024
 end
 )";
-    const std::string file = directory + ".prm";
-    if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-      std::ofstream(file) << text.str();
-    MPI_Barrier(MPI_COMM_WORLD);
-    ParameterHandler prm;
-    Simulation<3>::declare_parameters(prm);
-    parse_parameter_file(prm, file);
-    Simulation<3> simulation(prm, file, MPI_COMM_WORLD);
-    simulation.run();
-  }
-
-
-  // The column @p name of the statistics rows (header first).
-  unsigned int
-  column(const std::vector<std::vector<std::string>> &rows,
-         const std::string                           &name)
-  {
-    for (unsigned int c = 0; c < rows[0].size(); ++c)
-      if (rows[0][c] == name)
-        return c;
-    AssertThrow(false, ExcMessage("no column " + name));
-    return 0;
+    run_scene<3>(directory + ".prm", text.str());
   }
 } // namespace
 
@@ -141,9 +120,10 @@ main(int argc, char **argv)
 
   {
     const auto         rows = read_csv_rows("fluidized/statistics.csv");
-    const unsigned int t = column(rows, "time"), dt = column(rows, "dt"),
-                       dp = column(rows, "pressure_drop"),
-                       in = column(rows, "boundary_flux_4");
+    const unsigned int t    = column_index(rows, "time"),
+                       dt   = column_index(rows, "dt"),
+                       dp   = column_index(rows, "pressure_drop"),
+                       in   = column_index(rows, "boundary_flux_4");
     double integral = 0, duration = 0;
     for (unsigned int r = 1; r < rows.size(); ++r)
       if (std::stod(rows[r][t]) > 0.4)
@@ -164,9 +144,9 @@ main(int argc, char **argv)
   }
   {
     const auto         rows = read_csv_rows("packed/statistics.csv");
-    const unsigned int dp   = column(rows, "pressure_drop"),
-                       in   = column(rows, "boundary_flux_4"),
-                       out  = column(rows, "boundary_flux_5");
+    const unsigned int dp   = column_index(rows, "pressure_drop"),
+                       in   = column_index(rows, "boundary_flux_4"),
+                       out  = column_index(rows, "boundary_flux_5");
     const double inflow     = -std::stod(rows.back()[in]);
     const double outflow    = std::stod(rows.back()[out]);
     std::cout << "packed: pressure drop below half the buoyant weight: "
