@@ -36,6 +36,13 @@ end
     "subsection Fluid\n set Enabled = false\nend\nsubsection Grains\n set "
     "Enabled = true\n set Radius = 0.05\n subsection Placement\n  set "
     "Shape = list\n  set Positions = 0.5, 0.1\n end\nend\n";
+  // A dry fill of a box (r = 0.025 at solid fraction 0.3), its Grains
+  // section left open for the size distribution.
+  const std::string dry_fill =
+    "subsection Fluid\n set Enabled = false\nend\nsubsection Grains\n set "
+    "Enabled = true\n set Radius = 0.025\n subsection Placement\n  set "
+    "Shape = box\n  set Center = 0.5, 0.5\n  set Size = 0.8, 0.8\n  set "
+    "Solid fraction = 0.3\n end\n";
   const std::vector<Case> cases = {
     {"unknown_parameter",
      "set Dimension = 2\nset Viscosityy = 1\n",
@@ -407,6 +414,42 @@ end
        dry_grain,
      "Boundary fluxes",
      "needs the fluid"},
+    {"size_classes_fractions_sum",
+     "set Dimension = 2\n" + good_mesh + dry_fill +
+       " set Size distribution = classes\n set Class radii = 0.02, "
+       "0.04\n set Class fractions = 0.5, 0.4\nend\n",
+     "Class fractions",
+     "0.5, 0.4"},
+    {"size_classes_without_fractions",
+     "set Dimension = 2\n" + good_mesh + dry_fill +
+       " set Size distribution = classes\n set Class radii = 0.02, "
+       "0.04\nend\n",
+     "Class fractions",
+     "volume fractions"},
+    {"size_classes_repeated_radius",
+     "set Dimension = 2\n" + good_mesh + dry_fill +
+       " set Size distribution = classes\n set Class radii = 0.02, "
+       "0.02\n set Class fractions = 0.5, 0.5\nend\n",
+     "Class radii",
+     "0.02, 0.02"},
+    {"size_uniform_spread_above_radius",
+     "set Dimension = 2\n" + good_mesh + dry_fill +
+       " set Size distribution = uniform\n set Radius spread = "
+       "0.03\nend\n",
+     "Radius spread",
+     "0.03"},
+    {"size_lognormal_spread_below_one",
+     "set Dimension = 2\n" + good_mesh + dry_fill +
+       " set Size distribution = lognormal\n set Radius spread = "
+       "0.5\nend\n",
+     "Radius spread",
+     "0.5"},
+    {"size_and_radius_distribution",
+     "set Dimension = 2\n" + good_mesh + dry_fill +
+       " set Size distribution = uniform\n set Radius spread = 0.01\n set "
+       "Radius distribution = normal\nend\n",
+     "Size distribution",
+     "uniform"},
     {"probe_outside",
      "set Dimension = 2\nsubsection Output\n set Probes = far: 2, 2\nend\n",
      "Probes",

@@ -2,6 +2,7 @@
 
 #include <immersed_grains/grains/grain_parameters.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -26,11 +27,41 @@ namespace ImmersedGrains
                         "One radius per grain (comma list); overrides Radius "
                         "and Radius distribution. With Shape = ball or box it "
                         "also sets how many grains are placed.");
+      prm.declare_entry(
+        "Size distribution",
+        "constant",
+        Selection("constant|uniform|lognormal|classes"),
+        "The radii of the grains that Shape = ball, box or lattice places: "
+        "constant (Radius); uniform in [Radius - Radius spread, Radius + "
+        "Radius spread]; lognormal with median Radius and geometric standard "
+        "deviation Radius spread (ln r normal with deviation ln(Radius "
+        "spread)), redrawn outside [Minimum radius, Maximum radius], by "
+        "default Radius / spread^3 and Radius * spread^3; classes: the radii "
+        "Class radii in the volume fractions Class fractions (exact numbers "
+        "with Solid fraction, numbers in proportion with Count; statistics "
+        "per class: class<k>_particles, _mean_velocity_*, _centroid_*).");
+      prm.declare_entry("Radius spread",
+                        "0",
+                        Double(0),
+                        "Size distribution = uniform: the half-width [m]; "
+                        "lognormal: the geometric standard deviation (>= 1, "
+                        "no unit).");
+      prm.declare_entry("Class radii",
+                        "",
+                        Anything(),
+                        "Size distribution = classes: the classes' radii "
+                        "[m], a comma list of distinct values.");
+      prm.declare_entry("Class fractions",
+                        "",
+                        Anything(),
+                        "Size distribution = classes: each class's share of "
+                        "the grains' volume, in the order of Class radii; "
+                        "they sum to 1.");
       prm.declare_entry("Radius distribution",
                         "constant",
                         Selection("constant|uniform|normal"),
-                        "Polydisperse radii for Shape = ball, box or "
-                        "lattice: constant (Radius), uniform in [Minimum "
+                        "The older way to draw radii (Size distribution is "
+                        "the newer): constant (Radius), uniform in [Minimum "
                         "radius, Maximum radius], or normal with mean Radius "
                         "and Radius deviation, redrawn outside the bounds.");
       prm.declare_entry("Minimum radius", "0", Double(0), "[m], see above.");
@@ -224,6 +255,111 @@ namespace ImmersedGrains
 
   namespace
   {
+    /** Grains/Size distribution other than constant, with Radius spread
+     *  or Class radii and Class fractions; sets radius_distribution and
+     *  the bounds the draws keep to. */
+    template <int dim>
+    void
+    parse_size_distribution(GrainParameters<dim>     &p,
+                            dealii::ParameterHandler &prm,
+                            const InputLocation      &where)
+    {
+      const std::string sizes = prm.get("Size distribution");
+      where.require(prm.get("Radius distribution") == "constant",
+                    "Size distribution",
+                    sizes,
+                    "Radius distribution = " + prm.get("Radius distribution") +
+                      " is set too: set only one of them");
+      p.radius_spread           = prm.get_double("Radius spread");
+      const std::string &spread = prm.get("Radius spread");
+      if (sizes == "uniform")
+      {
+        where.require(p.radius_spread < p.radius,
+                      "Radius spread",
+                      spread,
+                      "the half-width of a uniform distribution must be "
+                      "below Radius (" +
+                        prm.get("Radius") + ")");
+        p.radius_distribution = RadiusDistribution::uniform;
+        p.min_radius          = p.radius - p.radius_spread;
+        p.max_radius          = p.radius + p.radius_spread;
+      }
+      else if (sizes == "lognormal")
+      {
+        where.require(p.radius_spread >= 1,
+                      "Radius spread",
+                      spread,
+                      "the geometric standard deviation of a lognormal "
+                      "distribution is at least 1");
+        p.radius_distribution = RadiusDistribution::lognormal;
+        // Three geometric deviations each side: 0.27 % of the draws are
+        // redrawn, and a spread of 1.5 keeps the size ratio below 12.
+        const double reach = std::pow(p.radius_spread, 3);
+        if (p.min_radius == 0)
+          p.min_radius = p.radius / reach;
+        if (p.max_radius == 0)
+          p.max_radius = p.radius * reach;
+        where.require(p.min_radius <= p.radius && p.radius <= p.max_radius,
+                      "Radius",
+                      prm.get("Radius"),
+                      "the median must lie in [Minimum radius, Maximum "
+                      "radius]");
+      }
+      else
+      {
+        p.radius_distribution  = RadiusDistribution::classes;
+        p.class_radii_text     = prm.get("Class radii");
+        p.class_fractions_text = prm.get("Class fractions");
+        p.class_radii =
+          parse_double_list(p.class_radii_text, where, "Class radii");
+        p.class_fractions =
+          parse_double_list(p.class_fractions_text, where, "Class fractions");
+        where.require(!p.class_radii.empty(),
+                      "Class radii",
+                      p.class_radii_text,
+                      "Size distribution = classes needs at least one radius");
+        double sum = 0;
+        for (unsigned int k = 0; k < p.class_radii.size(); ++k)
+        {
+          where.require(p.class_radii[k] > 0,
+                        "Class radii",
+                        p.class_radii_text,
+                        "radii must be positive");
+          for (unsigned int j = 0; j < k; ++j)
+            where.require(p.class_radii[j] != p.class_radii[k],
+                          "Class radii",
+                          p.class_radii_text,
+                          "two classes have the same radius");
+        }
+        p.min_radius =
+          *std::min_element(p.class_radii.begin(), p.class_radii.end());
+        p.max_radius =
+          *std::max_element(p.class_radii.begin(), p.class_radii.end());
+        // Grains from a list or a file carry their radii: the fractions
+        // are for fills (checked with the placement).
+        if (p.class_fractions.empty())
+          return;
+        where.require(p.class_fractions.size() == p.class_radii.size(),
+                      "Class fractions",
+                      p.class_fractions_text,
+                      "needs one fraction per class radius (" +
+                        std::to_string(p.class_radii.size()) + ")");
+        for (const double f : p.class_fractions)
+        {
+          where.require(f >= 0,
+                        "Class fractions",
+                        p.class_fractions_text,
+                        "fractions must not be negative");
+          sum += f;
+        }
+        where.require(std::abs(sum - 1) < 1e-6,
+                      "Class fractions",
+                      p.class_fractions_text,
+                      "the volume fractions must sum to 1");
+      }
+    }
+
+
     /** Grains/Fixed region: two corners, or empty. */
     template <int dim>
     void
@@ -296,6 +432,36 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  unsigned int
+  GrainParameters<dim>::n_classes() const
+  {
+    return radius_distribution == RadiusDistribution::classes ?
+             class_radii.size() :
+             0;
+  }
+
+
+  template <int dim>
+  int
+  GrainParameters<dim>::class_of(const double r) const
+  {
+    for (unsigned int k = 0; k < n_classes(); ++k)
+      if (std::abs(r - class_radii[k]) <= 1e-9 * class_radii[k])
+        return k;
+    return -1;
+  }
+
+
+  template <int dim>
+  double
+  GrainParameters<dim>::largest_drawn_radius() const
+  {
+    return radius_distribution == RadiusDistribution::constant ? radius :
+                                                                 max_radius;
+  }
+
+
+  template <int dim>
   void
   GrainParameters<dim>::parse_parameters(dealii::ParameterHandler &prm,
                                          const std::string        &file_name)
@@ -319,10 +485,13 @@ namespace ImmersedGrains
         (distribution == "uniform" ? RadiusDistribution::uniform :
          distribution == "normal"  ? RadiusDistribution::normal :
                                      RadiusDistribution::constant);
-      min_radius       = prm.get_double("Minimum radius");
-      max_radius       = prm.get_double("Maximum radius");
-      radius_deviation = prm.get_double("Radius deviation");
-      if (radius_distribution != RadiusDistribution::constant)
+      min_radius              = prm.get_double("Minimum radius");
+      max_radius              = prm.get_double("Maximum radius");
+      radius_deviation        = prm.get_double("Radius deviation");
+      const std::string sizes = prm.get("Size distribution");
+      if (sizes != "constant")
+        parse_size_distribution(*this, prm, where);
+      else if (radius_distribution != RadiusDistribution::constant)
         where.require(min_radius > 0 && max_radius >= min_radius,
                       "Maximum radius",
                       prm.get("Maximum radius"),
@@ -405,6 +574,15 @@ namespace ImmersedGrains
             path = std::filesystem::path(file).parent_path() / path;
           placement_path = path.lexically_normal().string();
         }
+        if (enabled && radius_distribution == RadiusDistribution::classes &&
+            radii.empty() &&
+            (shape == PlacementShape::ball || shape == PlacementShape::box ||
+             shape == PlacementShape::lattice))
+          where.require(!class_fractions.empty(),
+                        "Class fractions",
+                        class_fractions_text,
+                        "a fill with Size distribution = classes needs the "
+                        "classes' volume fractions");
         if (enabled && shape == PlacementShape::list)
           place.require(!positions.empty(),
                         "Positions",

@@ -685,6 +685,25 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::vector<std::string>
+  GrainStatistics<dim>::class_column_names(const unsigned int n_classes)
+  {
+    const char              *axes[] = {"x", "y", "z"};
+    std::vector<std::string> c;
+    for (unsigned int k = 0; k < n_classes; ++k)
+    {
+      const std::string prefix = "class" + std::to_string(k) + "_";
+      c.push_back(prefix + "particles");
+      for (unsigned int d = 0; d < dim; ++d)
+        c.push_back(prefix + "mean_velocity_" + axes[d]);
+      for (unsigned int d = 0; d < dim; ++d)
+        c.push_back(prefix + "centroid_" + axes[d]);
+    }
+    return c;
+  }
+
+
+  template <int dim>
   void
   GrainStatistics<dim>::set_statistics(Statistics &statistics,
                                        const bool  without_fluid) const
@@ -708,6 +727,17 @@ namespace ImmersedGrains
     statistics.set("grains_removed", n_removed);
     for (unsigned int d = 0; d < dim; ++d)
       statistics.set(std::string("grains_max_") + axes[d], max_position[d]);
+    for (unsigned int k = 0; k < class_grains.size(); ++k)
+    {
+      const std::string prefix = "class" + std::to_string(k) + "_";
+      statistics.set(prefix + "particles", class_grains[k]);
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        statistics.set(prefix + "mean_velocity_" + axes[d],
+                       class_mean_velocity[k][d]);
+        statistics.set(prefix + "centroid_" + axes[d], class_centroid[k][d]);
+      }
+    }
   }
 
 
@@ -1063,10 +1093,13 @@ namespace ImmersedGrains
     for (unsigned int d = 1; d < dim; ++d)
       if (std::abs(down[d]) > std::abs(down[axis]))
         axis = d;
-    const double        floor = down[axis] < 0 ? geometry.lower_corner[axis] :
-                                                 geometry.upper_corner[axis];
-    const unsigned int  fixed_sums = 3 + 2 * dim + 1;
-    std::vector<double> sums(fixed_sums + 1 + dim, 0.);
+    const double       floor = down[axis] < 0 ? geometry.lower_corner[axis] :
+                                                geometry.upper_corner[axis];
+    const unsigned int fixed_sums = 3 + 2 * dim + 1;
+    // Then per class: count, sum x, sum v.
+    const unsigned int  class_sums = fixed_sums + 1 + dim;
+    const unsigned int  n_classes  = parameters.n_classes();
+    std::vector<double> sums(class_sums + n_classes * (1 + 2 * dim), 0.);
     // The largest speed and the largest centre coordinates, reduced
     // together.
     std::vector<double> maxima(1 + dim, std::numeric_limits<double>::lowest());
@@ -1105,6 +1138,16 @@ namespace ImmersedGrains
         for (unsigned int d = 0; d < dim; ++d)
           sums[fixed_sums + 1 + d] += p.get_location()[d];
       }
+      if (const int k = parameters.class_of(r); k >= 0)
+      {
+        double *class_sum = &sums[class_sums + k * (1 + 2 * dim)];
+        class_sum[0] += 1;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          class_sum[1 + d] += p.get_location()[d];
+          class_sum[1 + dim + d] += v[d];
+        }
+      }
     }
     dealii::Utilities::MPI::sum(sums, comm, sums);
 
@@ -1139,6 +1182,20 @@ namespace ImmersedGrains
         height > 0 ? s.solid_volume / (section * 2 * height) : 0;
     }
     s.n_removed = removed_total;
+    s.class_grains.assign(n_classes, 0.);
+    s.class_centroid.assign(n_classes, dealii::Point<dim>());
+    s.class_mean_velocity.assign(n_classes, dealii::Tensor<1, dim>());
+    for (unsigned int k = 0; k < n_classes; ++k)
+    {
+      const double *class_sum = &sums[class_sums + k * (1 + 2 * dim)];
+      s.class_grains[k]       = class_sum[0];
+      if (class_sum[0] > 0)
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          s.class_centroid[k][d]      = class_sum[1 + d] / class_sum[0];
+          s.class_mean_velocity[k][d] = class_sum[1 + dim + d] / class_sum[0];
+        }
+    }
     return s;
   }
 

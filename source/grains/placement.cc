@@ -54,6 +54,25 @@ namespace ImmersedGrains
       return s.str();
     }
 
+    // Each class's share of the grains' number: its volume fraction over
+    // its grain's volume, normalised.
+    template <int dim>
+    std::vector<double>
+    class_number_shares(const GrainParameters<dim> &prm)
+    {
+      std::vector<double> shares;
+      double              sum = 0;
+      for (unsigned int k = 0; k < prm.class_radii.size(); ++k)
+      {
+        shares.push_back(prm.class_fractions[k] /
+                         grain_volume<dim>(prm.class_radii[k]));
+        sum += shares.back();
+      }
+      for (double &s : shares)
+        s /= sum;
+      return shares;
+    }
+
     template <int dim>
     double
     draw_radius(const GrainParameters<dim> &prm, Random &random)
@@ -69,9 +88,88 @@ namespace ImmersedGrains
             if (r >= prm.min_radius && r <= prm.max_radius)
               return r;
           }
+        case RadiusDistribution::lognormal:
+          for (;;)
+          {
+            const double r = prm.radius * std::exp(std::log(prm.radius_spread) *
+                                                   random.normal(0, 1));
+            if (r >= prm.min_radius && r <= prm.max_radius)
+              return r;
+          }
+        case RadiusDistribution::classes:
+        {
+          // A class drawn with its share of the grains' number.
+          const std::vector<double> shares = class_number_shares(prm);
+          double                    u      = random.uniform();
+          for (unsigned int k = 0; k + 1 < shares.size(); ++k)
+            if ((u -= shares[k]) < 0)
+              return prm.class_radii[k];
+          return prm.class_radii.back();
+        }
         default:
           return prm.radius;
       }
+    }
+
+    // Each class's exact number of grains: @p total split in proportion
+    // to @p weights, the remainders going to the largest fractional parts
+    // (the earlier class on a tie).
+    std::vector<unsigned int>
+    apportion(const unsigned int total, const std::vector<double> &weights)
+    {
+      double sum = 0;
+      for (const double w : weights)
+        sum += w;
+      std::vector<unsigned int> n(weights.size());
+      std::vector<double>       rest(weights.size());
+      unsigned int              given = 0;
+      for (unsigned int k = 0; k < weights.size(); ++k)
+      {
+        const double exact = total * weights[k] / sum;
+        n[k]               = static_cast<unsigned int>(std::floor(exact));
+        rest[k]            = exact - n[k];
+        given += n[k];
+      }
+      std::vector<unsigned int> order(weights.size());
+      for (unsigned int k = 0; k < order.size(); ++k)
+        order[k] = k;
+      std::stable_sort(order.begin(),
+                       order.end(),
+                       [&](unsigned int a, unsigned int b)
+                       { return rest[a] > rest[b]; });
+      for (unsigned int k = 0; given < total; ++k, ++given)
+        ++n[order[k % order.size()]];
+      return n;
+    }
+
+    // The classes' radii for a fill: with Solid fraction, each class
+    // fills its share of the solid volume (the nearest whole number of
+    // grains); with Count, the count is split by the classes' shares of
+    // the number.
+    template <int dim>
+    std::vector<double>
+    class_radii_of_fill(const GrainParameters<dim> &prm,
+                        const double                region_volume)
+    {
+      const InputLocation       where{prm.file, "Grains/Placement"};
+      std::vector<unsigned int> n;
+      where.require(prm.count <= 50'000'000,
+                    "Count",
+                    prm.count_text,
+                    "more than 5e7 grains");
+      if (prm.count > 0)
+        n = apportion(prm.count, class_number_shares(prm));
+      else
+        for (unsigned int k = 0; k < prm.class_radii.size(); ++k)
+          n.push_back(static_cast<unsigned int>(
+            std::min(5e7,
+                     std::round(prm.class_fractions[k] * prm.solid_fraction *
+                                region_volume /
+                                grain_volume<dim>(prm.class_radii[k])))));
+      std::vector<double> radii;
+      for (unsigned int k = 0; k < n.size(); ++k)
+        radii.insert(radii.end(), n[k], prm.class_radii[k]);
+      return radii;
     }
 
     // The radii of a ball or box fill: Radii, Count draws, or draws until
@@ -84,6 +182,8 @@ namespace ImmersedGrains
     {
       if (!prm.radii.empty())
         return prm.radii;
+      if (prm.radius_distribution == RadiusDistribution::classes)
+        return class_radii_of_fill(prm, region_volume);
       std::vector<double> radii;
       if (prm.count > 0)
       {
@@ -364,9 +464,7 @@ namespace ImmersedGrains
     {
       const InputLocation where{prm.file, "Grains/Placement"};
       std::vector<double> radii = prm.radii;
-      double r_max = prm.radius_distribution == RadiusDistribution::constant ?
-                       prm.radius :
-                       prm.max_radius;
+      double              r_max = prm.largest_drawn_radius();
       if (!radii.empty())
         r_max = *std::max_element(radii.begin(), radii.end());
       std::array<unsigned int, dim> n;

@@ -230,6 +230,12 @@ namespace ImmersedGrains
                 prm.get("Courant number"),
                 "must be positive with Adaptive time step");
 
+    // Before Output: its Test columns and Test checks may name the size
+    // classes' columns.
+    grain_parameters.parse_parameters(prm, file);
+    statistics.add_columns(
+      GrainStatistics<dim>::class_column_names(grain_parameters.n_classes()));
+
     prm.enter_subsection("Output");
     {
       const InputLocation where{file, "Output"};
@@ -308,7 +314,6 @@ namespace ImmersedGrains
         name,
         *text,
         "needs the fluid (Fluid/Enabled = true)");
-    grain_parameters.parse_parameters(prm, file);
     coupling_parameters.parse_parameters(prm, file);
     adaptivity_parameters.parse_parameters(prm, file, fluid_parameters.enabled);
     // A placement or contact law written for grains that are off would be

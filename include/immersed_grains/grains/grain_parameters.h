@@ -13,12 +13,16 @@
 
 namespace ImmersedGrains
 {
-  /** How the radii of randomly placed grains are drawn. */
+  /** How the radii of randomly placed grains are drawn (`Size
+   *  distribution`, or the older `Radius distribution`). */
   enum class RadiusDistribution
   {
-    constant, // every grain has Radius
-    uniform,  // uniform in [Minimum radius, Maximum radius]
-    normal    // normal(Radius, Radius deviation), redrawn outside the bounds
+    constant,  // every grain has Radius
+    uniform,   // uniform in [min_radius, max_radius]
+    normal,    // normal(Radius, Radius deviation), redrawn outside the bounds
+    lognormal, // median Radius, geometric deviation Radius spread,
+               // redrawn outside [min_radius, max_radius]
+    classes    // Class radii in the volume fractions Class fractions
   };
 
   /** Where the initial grains come from (`subsection Placement`). */
@@ -56,14 +60,36 @@ namespace ImmersedGrains
     double              min_radius          = 1e-3;
     double              max_radius          = 1e-3;
     double              radius_deviation    = 0;
-    double              density             = 2500;
-    bool                fixed               = false;
-    double              max_displacement    = 0.125; // of the smallest radius
+    /// Size distribution: uniform's half-width or lognormal's geometric
+    /// standard deviation.
+    double              radius_spread = 0;
+    std::vector<double> class_radii;     // Size distribution = classes
+    std::vector<double> class_fractions; // their volume fractions, sum 1
+    std::string         class_radii_text, class_fractions_text;
+    double              density          = 2500;
+    bool                fixed            = false;
+    double              max_displacement = 0.125; // of the smallest radius
     /// Fixed region: grains whose centre lies in this closed box at
     /// placement are fixed (a bed others fall onto); none if not set.
     bool               has_fixed_region = false;
     dealii::Point<dim> fixed_region_lower, fixed_region_upper;
     std::string        fixed_region_text;
+
+    /** The size classes whose statistics are written (Size distribution =
+     *  classes), 0 otherwise. */
+    unsigned int
+    n_classes() const;
+
+    /** The class of a grain of radius @p r: the class radius within a
+     *  relative 1e-9 of it, or -1 (a grain read from a file or a list
+     *  with another radius). */
+    int
+    class_of(double r) const;
+
+    /** The largest radius the distribution draws (the lattice's
+     *  spacing). */
+    double
+    largest_drawn_radius() const;
 
     /** Whether a grain placed at @p x is fixed (Fixed, or Fixed region). */
     bool

@@ -145,11 +145,21 @@ namespace ImmersedGrains
     /** The largest coordinate of any grain's centre, per axis (run-outs,
      *  bed heights; 0 without grains). */
     dealii::Point<dim> max_position;
+    /** Per size class (Size distribution = classes, in the order of Class
+     *  radii; empty otherwise): the number of grains, the mean of their
+     *  centres and of their velocities. */
+    std::vector<double>                 class_grains;
+    std::vector<dealii::Point<dim>>     class_centroid;
+    std::vector<dealii::Tensor<1, dim>> class_mean_velocity;
 
     /** The statistics columns these fill (doc/output.md); solid_volume
      *  only @p without_fluid (else the coupling's projection). */
     static std::vector<std::string>
     column_names();
+    /** The columns of @p n_classes size classes: class<k>_particles,
+     *  class<k>_mean_velocity_x, ..., class<k>_centroid_x, ... */
+    static std::vector<std::string>
+    class_column_names(unsigned int n_classes);
     void
     set_statistics(Statistics &statistics, bool without_fluid) const;
   };
