@@ -1,7 +1,9 @@
 // The bucket grid against a brute-force O(N^2) search with the nearest
 // periodic image: random polydisperse grains (some outside the box on
 // non-periodic axes), in 2D and 3D, with no, some and all axes periodic,
-// including periodic axes only two or three buckets long. Every pair, gap,
+// including periodic axes only two or three buckets long, and grains of
+// size ratio 10 (a few large among many small, the large scanning the
+// buckets of the small). Every pair, gap,
 // normal and shift must agree (to 1e-12 of the radius), and the list must be
 // sorted by (i, j). Also the walls of a box against their definition.
 
@@ -35,7 +37,8 @@ namespace
   void
   compare(const std::array<bool, dim> &periodic,
           const unsigned int           n,
-          const double                 box_length)
+          const double                 box_length,
+          const double                 large_share = 0)
   {
     Point<dim> lower, upper;
     for (unsigned int d = 0; d < dim; ++d)
@@ -44,7 +47,12 @@ namespace
     std::vector<double>     r(n);
     for (unsigned int i = 0; i < n; ++i)
     {
-      r[i] = uniform(0.5, 1.0);
+      // Without large_share: radii within a factor 2. With it: that share
+      // of grains ten times larger than the rest, which get buckets of
+      // their own size.
+      r[i] = large_share == 0 ? uniform(0.5, 1.0) :
+             uniform(0, 1) < large_share ? uniform(1.0, 1.5) :
+                                           uniform(0.1, 0.15);
       for (unsigned int d = 0; d < dim; ++d)
         // Periodic axes: anywhere, even several periods away. Others: some
         // grains a little outside the box.
@@ -169,6 +177,11 @@ main()
   compare<3>({{true, true, true}}, 20, 7.5); // three buckets per axis
   box_walls<2>();
   box_walls<3>();
+  // Size ratio 10: 2 % of the grains large among small ones.
+  compare<2>({{false, false}}, 4000, 20, 0.02);
+  compare<2>({{true, true}}, 4000, 20, 0.02);
+  compare<3>({{false, false, false}}, 6000, 12, 0.02);
+  compare<3>({{true, false, true}}, 6000, 12, 0.02);
   std::printf("%s\n", all_ok ? "OK" : "FAILED");
   return all_ok ? 0 : 1;
 }

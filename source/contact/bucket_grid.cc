@@ -44,6 +44,7 @@ namespace ImmersedGrains
     template <int dim>
     void
     BucketGrid<dim>::choose_buckets(const unsigned int n_grains,
+                                    const double       largest_reach,
                                     const double       min_size)
     {
       // A very sparse population in a large box would otherwise ask for more
@@ -56,7 +57,7 @@ namespace ImmersedGrains
       for (unsigned int d = 0; d < dim; ++d)
       {
         if (periodic[d])
-          AssertThrow(extent[d] >= 2 * min_size,
+          AssertThrow(extent[d] >= 2 * largest_reach,
                       dealii::ExcMessage(
                         "BucketGrid: a periodic axis must be at least two "
                         "times (largest diameter + alert distance) long, "
@@ -169,8 +170,30 @@ namespace ImmersedGrains
       if (n_grains == 0)
         return;
 
-      const double max_radius = *std::max_element(radii.begin(), radii.end());
-      const double min_size   = 2 * max_radius + alert_distance;
+      // Buckets sized by the largest "small" radius r_cut, not by the
+      // largest grain: with a few large grains among many small ones,
+      // buckets of the large grains' size would hold (R/r)^dim small ones
+      // each. A small grain (r <= r_cut) finds its small partners in the
+      // adjacent buckets; a large one scans the buckets within
+      // r_i + r_max + alert and finds every pair it is part of.
+      const auto [min_it, max_it] =
+        std::minmax_element(radii.begin(), radii.end());
+      const double max_radius = *max_it;
+      double       cut_radius = max_radius;
+      if (max_radius > 2 * *min_it)
+      {
+        // The 90th percentile, at least twice the smallest radius: a
+        // tenth of the grains scanning wider is cheaper than every grain
+        // scanning buckets sized for the largest.
+        sort_buffer_radius.assign(radii.begin(), radii.end());
+        auto nth =
+          sort_buffer_radius.begin() + static_cast<long>(0.9 * (n_grains - 1));
+        std::nth_element(sort_buffer_radius.begin(),
+                         nth,
+                         sort_buffer_radius.end());
+        cut_radius = std::min(max_radius, std::max(2 * *min_it, *nth));
+      }
+      const double min_size = 2 * cut_radius + alert_distance;
       // Buckets over the grains' bounding box within the domain on the
       // non-periodic axes. Over the whole domain, a cloud of 10,000
       // spheres in a box 14 cloud radii wide got buckets of 0.3 mm holding
@@ -192,7 +215,7 @@ namespace ImmersedGrains
         grid_lower[d]  = std::min(lo, hi);
         grid_extent[d] = std::max(hi - lo, min_size);
       }
-      choose_buckets(n_grains, min_size);
+      choose_buckets(n_grains, 2 * max_radius + alert_distance, min_size);
       sort_grains_into_buckets(positions, radii);
 
       bool any_periodic = false;
@@ -211,41 +234,49 @@ namespace ImmersedGrains
       // with N (241 to 455 ns from 1e3 to 1e5 grains in 3D, doc/contacts.md),
       // even for grains given in spatial order. Callers pass grains in
       // the ParticleHandler's cell order, so the buckets one grain reads
-      // are mostly those its predecessor read.
+      // are mostly those its predecessor read. A large grain's pairs with
+      // small grains of lower index go to a second list, merged at the end.
       const auto &xs = wrapped_position;
       const auto &rs = sorted_radius;
+      late_pairs.clear();
+      std::array<std::vector<unsigned int>, dim> around;
       for (unsigned int i = 0; i < n_grains; ++i)
       {
+        const double ri    = radii[i];
+        const bool   large = ri > cut_radius;
         // The distinct bucket coordinates around grain i on each axis
-        // (fewer than three at a wall, or on a short periodic axis).
-        std::array<std::array<unsigned int, 3>, dim> around;
-        std::array<unsigned int, dim>                n_around;
+        // (fewer at a wall, or on a short periodic axis).
         for (unsigned int d = 0; d < dim; ++d)
         {
           const int n = n_buckets_per_axis[d];
           const int c = (bucket_of_grain[i] / stride[d]) % n;
-          n_around[d] = 0;
-          for (int o = -1; o <= 1; ++o)
+          const int k =
+            large ?
+              static_cast<int>(
+                std::min<double>(n,
+                                 std::ceil((ri + max_radius + alert_distance) /
+                                           bucket_size[d]))) :
+              1;
+          around[d].clear();
+          for (int o = -k; o <= k; ++o)
           {
             int b = c + o;
             if (b < 0 || b >= n)
             {
               if (!periodic[d])
                 continue;
-              b = (b + n) % n;
+              b = ((b % n) + n) % n;
             }
             if (std::find(around[d].begin(),
-                          around[d].begin() + n_around[d],
-                          static_cast<unsigned int>(b)) ==
-                around[d].begin() + n_around[d])
-              around[d][n_around[d]++] = b;
+                          around[d].end(),
+                          static_cast<unsigned int>(b)) == around[d].end())
+              around[d].push_back(b);
           }
         }
 
         Point<dim> xi;
         for (unsigned int d = 0; d < dim; ++d)
           xi[d] = positions[i][d] - wrap_count[i][d] * extent[d];
-        const double       ri    = radii[i];
         const unsigned int first = pairs.size();
         // Grains in slots [begin, end) of the bucket order.
         const auto scan = [&](const unsigned int begin, const unsigned int end)
@@ -253,7 +284,12 @@ namespace ImmersedGrains
           for (unsigned int l = begin; l < end; ++l)
           {
             const unsigned int j = grain_in_order[l];
-            if (j <= i)
+            // A small grain pairs here with small grains of higher index;
+            // a large one with every grain of higher index and with the
+            // small ones of lower index (which skip it).
+            const bool j_large = rs[l] > cut_radius;
+            if (j == i || (!large && (j < i || j_large)) ||
+                (large && j < i && j_large))
               continue;
             Tensor<1, dim>       d = xs[l] - xi;
             std::array<int, dim> image{};
@@ -272,22 +308,28 @@ namespace ImmersedGrains
             if (dist2 >= reach * reach)
               continue;
 
+            // Stored with first < second: seen from j when j < i.
+            const bool     flip = j < i;
             GrainPair<dim> pair;
-            pair.first        = i;
-            pair.second       = j;
+            pair.first        = flip ? j : i;
+            pair.second       = flip ? i : j;
             const double dist = std::sqrt(dist2);
             if (dist > 0)
-              pair.normal = d / dist;
+              pair.normal = (flip ? -d : d) / dist;
             else
               pair.normal[0] = 1; // coincident centres: any unit vector
             pair.gap = dist - ri - rs[l];
             // d = (x_j + shift) - x_i with shift a whole number of periods.
             for (unsigned int a = 0; a < dim; ++a)
               if (periodic[a])
+              {
                 pair.shift[a] =
                   (wrap_count[j][a] - wrap_count[i][a]) * -extent[a] +
                   image[a] * extent[a];
-            pairs.push_back(pair);
+                if (flip)
+                  pair.shift[a] = -pair.shift[a];
+              }
+            (flip ? late_pairs : pairs).push_back(pair);
           }
         };
 
@@ -300,16 +342,15 @@ namespace ImmersedGrains
           for (unsigned int d = 1; d < dim; ++d)
             row += stride[d] * around[d][q[d]];
           if (!periodic[0])
-            scan(bucket_start[row + around[0][0]],
-                 bucket_start[row + around[0][n_around[0] - 1] + 1]);
+            scan(bucket_start[row + around[0].front()],
+                 bucket_start[row + around[0].back() + 1]);
           else
-            for (unsigned int k = 0; k < n_around[0]; ++k)
-              scan(bucket_start[row + around[0][k]],
-                   bucket_start[row + around[0][k] + 1]);
+            for (const unsigned int b : around[0])
+              scan(bucket_start[row + b], bucket_start[row + b + 1]);
           unsigned int d = 1;
           for (; d < dim; ++d)
           {
-            if (++q[d] < n_around[d])
+            if (++q[d] < around[d].size())
               break;
             q[d] = 0;
           }
@@ -320,6 +361,21 @@ namespace ImmersedGrains
                   pairs.end(),
                   [](const GrainPair<dim> &a, const GrainPair<dim> &b)
                   { return a.second < b.second; });
+      }
+      if (!late_pairs.empty())
+      {
+        const auto order = [](const GrainPair<dim> &a, const GrainPair<dim> &b)
+        {
+          return a.first < b.first ||
+                 (a.first == b.first && a.second < b.second);
+        };
+        std::sort(late_pairs.begin(), late_pairs.end(), order);
+        const auto middle = pairs.size();
+        pairs.insert(pairs.end(), late_pairs.begin(), late_pairs.end());
+        std::inplace_merge(pairs.begin(),
+                           pairs.begin() + middle,
+                           pairs.end(),
+                           order);
       }
     }
 

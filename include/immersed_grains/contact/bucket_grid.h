@@ -42,14 +42,18 @@ namespace ImmersedGrains
      * independent of any finite element mesh: O(N) for a bounded number of
      * grains per bucket.
      *
-     * The bucket edge is at least the largest diameter plus the alert
-     * distance, so every pair closer than the alert distance lies in the same
-     * or in adjacent buckets. Grains outside the box on a non-periodic axis
-     * are clamped into the outermost bucket layer, which keeps the search
-     * correct (only slower) for grains that escaped through a wall. On a
-     * periodic axis positions are wrapped and pairs use the nearest image;
-     * that axis must be at least two bucket edges long, so that no grain can
-     * see two images of the same neighbour.
+     * The bucket edge is at least the diameter of the largest "small"
+     * grain (the 90th percentile of the radii, at least twice the smallest
+     * radius, or the largest grain when all are within a factor 2) plus the
+     * alert distance, so every pair of small grains closer than the alert
+     * distance lies in the same or in adjacent buckets; a larger grain
+     * scans the buckets within its reach. A few large grains among many
+     * small ones thus keep the search O(N). Grains outside the box on a
+     * non-periodic axis are clamped into the outermost bucket layer, which
+     * keeps the search correct (only slower) for grains that escaped through a
+     * wall. On a periodic axis positions are wrapped and pairs use the nearest
+     * image; that axis must be at least two bucket edges long, so that no grain
+     * can see two images of the same neighbour.
      *
      * The object keeps its work arrays between calls, so that a time loop
      * does not allocate once the grain count is steady.
@@ -102,9 +106,17 @@ namespace ImmersedGrains
       std::vector<double>               sorted_radius;
       std::vector<std::array<int, dim>> wrap_count;
       std::vector<unsigned int>         sort_buffer;
+      std::vector<double>               sort_buffer_radius;
+      // Pairs of a large grain with small grains of lower index.
+      std::vector<GrainPair<dim>> late_pairs;
 
+      /** Buckets of edge at least @p min_size; a periodic axis must be at
+       *  least twice @p largest_reach (the largest diameter plus the alert
+       *  distance) long. */
       void
-      choose_buckets(const unsigned int n_grains, const double min_size);
+      choose_buckets(const unsigned int n_grains,
+                     const double       largest_reach,
+                     const double       min_size);
 
       void
       sort_grains_into_buckets(const std::vector<Point<dim>> &positions,
