@@ -48,9 +48,9 @@ namespace
     for (unsigned int i = 0; i < n; ++i)
     {
       // Without large_share: radii within a factor 2. With it: that share
-      // of grains ten times larger than the rest, which get buckets of
-      // their own size.
-      r[i] = large_share == 0 ? uniform(0.5, 1.0) :
+      // of grains ten times larger than the rest, which scan the small
+      // grains' buckets within their reach.
+      r[i] = large_share == 0            ? uniform(0.5, 1.0) :
              uniform(0, 1) < large_share ? uniform(1.0, 1.5) :
                                            uniform(0.1, 0.15);
       for (unsigned int d = 0; d < dim; ++d)
