@@ -118,6 +118,14 @@ end
      "0.5; 0.6, 0.5\n  end\nend\n",
      "Positions",
      "0.5, 0.5; 0.6, 0.5"},
+    // Beyond the overlap the contact solver leaves (Contacts/Overlap
+    // tolerance, 1e-3 r): 2e-3 r.
+    {"grains_overlap_beyond_tolerance",
+     "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
+     "Radius = 0.1\n  subsection Placement\n    set Positions = 0.5, "
+     "0.5; 0.6998, 0.5\n  end\nend\n",
+     "Positions",
+     "0.5, 0.5; 0.6998, 0.5"},
     {"grains_outside_domain",
      "set Dimension = 2\nsubsection Grains\n  set Enabled = true\n  set "
      "Radius = 0.1\n  subsection Placement\n    set Positions = 0.5, "

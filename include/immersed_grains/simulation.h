@@ -271,13 +271,14 @@ namespace ImmersedGrains
     // When the cloud broke up (-1: not yet).
     double breakup_time = -1;
 
-    unsigned int                    write_fields_every = 0;
-    OutputFormat                    output_format      = OutputFormat::vtu;
-    bool                            test_output        = false;
-    bool                            quiet              = false;
-    bool                            verbose            = false;
-    double                          progress_interval  = 10;
-    double                          start_time         = 0;
+    unsigned int                    write_fields_every      = 0;
+    bool                            write_grain_file_at_end = false;
+    OutputFormat                    output_format           = OutputFormat::vtu;
+    bool                            test_output             = false;
+    bool                            quiet                   = false;
+    bool                            verbose                 = false;
+    double                          progress_interval       = 10;
+    double                          start_time              = 0;
     std::vector<std::string>        test_columns;
     unsigned int                    test_every = 1;
     std::vector<TestCheck>          test_checks;

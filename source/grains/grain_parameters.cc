@@ -143,7 +143,11 @@ namespace ImmersedGrains
                           "Shape = file: one grain per line, 'x y [z] [r "
                           "[vx vy [vz]]]' separated by spaces or commas; "
                           "'#' starts a comment. A relative path is read "
-                          "from the folder of the parameter file.");
+                          "from the folder of the parameter file. Grains may "
+                          "overlap each other and the walls by Contacts/"
+                          "Overlap tolerance times their radius, what a run "
+                          "that wrote the file (Output/Write grain file) "
+                          "leaves.");
       }
       prm.leave_subsection();
     }

@@ -570,6 +570,7 @@ namespace ImmersedGrains
     void
     check_overlaps(const std::vector<GrainSeed<dim>> &grains,
                    const Geometry<dim>               &geometry,
+                   const double                       allowed_overlap,
                    const InputLocation               &where,
                    const std::string                 &parameter,
                    const std::string                 &value)
@@ -602,7 +603,7 @@ namespace ImmersedGrains
       std::vector<Contact::GrainPair<dim>> pairs;
       grid.find_pairs(x, r, 0, pairs);
       for (const auto &p : pairs)
-        if (p.gap < -1e-9 * r_min)
+        if (p.gap < -allowed_overlap * r_min)
           where.fail(parameter,
                      value,
                      "grains " + std::to_string(p.first + 1) + " at " +
@@ -616,6 +617,7 @@ namespace ImmersedGrains
     void
     check_inside(const std::vector<GrainSeed<dim>> &grains,
                  const Geometry<dim>               &geometry,
+                 const double                       allowed_overlap,
                  const InputLocation               &where,
                  const std::string                 &parameter,
                  const std::string                 &value)
@@ -638,7 +640,7 @@ namespace ImmersedGrains
                        value,
                        name + " is outside the mesh " + geometry.mesh_file);
           const double clearance = walls.clearance(g.position, g.radius, 0);
-          if (clearance < -1e-9 * g.radius)
+          if (clearance < -allowed_overlap * g.radius)
             where.fail(parameter,
                        value,
                        name + " overlaps a wall of the mesh by " +
@@ -650,7 +652,9 @@ namespace ImmersedGrains
         for (unsigned int d = 0; d < dim; ++d)
         {
           const double x   = grains[k].position[d];
-          const double r   = geometry.is_periodic(d) ? 0 : grains[k].radius;
+          const double r   = geometry.is_periodic(d) ?
+                               0 :
+                               grains[k].radius * (1 - allowed_overlap);
           const double eps = 1e-12 * (hi[d] - lo[d]);
           if (x - r < lo[d] - eps || x + r > hi[d] + eps ||
               (geometry.is_periodic(d) && x >= hi[d]))
@@ -739,11 +743,17 @@ namespace ImmersedGrains
 
     if (grains.empty())
       return grains;
-    check_inside(grains, geometry, place, parameter, value);
+    // A packing the contact solver made (a file another run wrote) holds
+    // overlaps up to its Overlap tolerance: it must read back.
+    const double allowed_overlap =
+      prm.contacts_enabled ? std::max(1e-9, prm.contact.overlap_tolerance) :
+                             1e-9;
+    check_inside(grains, geometry, allowed_overlap, place, parameter, value);
     if ((prm.shape != PlacementShape::ball &&
          prm.shape != PlacementShape::box) ||
         prm.centers.size() > 1)
-      check_overlaps(grains, geometry, place, parameter, value);
+      check_overlaps(
+        grains, geometry, allowed_overlap, place, parameter, value);
     return grains;
   }
 

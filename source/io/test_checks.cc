@@ -3,13 +3,35 @@
 #include <immersed_grains/io/test_checks.h>
 
 #include <sstream>
+#include <utility>
 
 namespace ImmersedGrains
 {
+  void
+  TestCheck::record(const Statistics &statistics)
+  {
+    if (extreme == 0)
+      return;
+    const double v = statistics.get(column);
+    if (!recorded || (extreme == '+' ? v > extreme_value : v < extreme_value))
+      extreme_value = v;
+    recorded = true;
+  }
+
+
+  double
+  TestCheck::value(const Statistics &statistics) const
+  {
+    if (extreme == 0 || !recorded)
+      return statistics.get(column);
+    return extreme_value;
+  }
+
+
   bool
   TestCheck::holds(const Statistics &statistics) const
   {
-    const double v = statistics.get(column);
+    const double v = value(statistics);
     switch (relation)
     {
       case '<':
@@ -39,6 +61,17 @@ namespace ImmersedGrains
       std::string        relation;
       in >> c.column >> relation;
       c.text = entry;
+      for (const auto &[name, sign] :
+           {std::pair<std::string, char>{"max(", '+'},
+            std::pair<std::string, char>{"min(", '-'}})
+        if (c.column.size() > name.size() + 1 &&
+            c.column.compare(0, name.size(), name) == 0 &&
+            c.column.back() == ')')
+        {
+          c.column =
+            c.column.substr(name.size(), c.column.size() - name.size() - 1);
+          c.extreme = sign;
+        }
       where.require(statistics.has(c.column),
                     parameter,
                     text,
@@ -68,7 +101,7 @@ namespace ImmersedGrains
                     text,
                     "'" + entry +
                       "' is not 'column < v', 'column > v' or 'column in "
-                      "[a, b]'");
+                      "[a, b]', column a name or max(name) or min(name)");
       checks.push_back(c);
     }
     return checks;
@@ -86,7 +119,7 @@ namespace ImmersedGrains
       if (c.holds(statistics))
         out << "yes\n";
       else
-        out << "no (value " << statistics.get(c.column) << ")\n";
+        out << "no (value " << c.value(statistics) << ")\n";
     }
     out.flush();
   }

@@ -5,6 +5,7 @@
 #include <immersed_grains/fluid/fluid_solver.h>
 #include <immersed_grains/grains/grains.h>
 #include <immersed_grains/io/field_output.h>
+#include <immersed_grains/io/grain_file.h>
 #include <immersed_grains/io/particle_output.h>
 #include <immersed_grains/io/progress_line.h>
 #include <immersed_grains/simulation.h>
@@ -100,6 +101,14 @@ namespace ImmersedGrains
                         "Write the fields and the grains every this many "
                         "steps (0: only the initial and the final state).");
       prm.declare_entry(
+        "Write grain file",
+        "false",
+        Bool(),
+        "At the end of the run, write every grain to grains.txt in the "
+        "output directory, a line 'x y [z] r vx vy [vz]' each, the format "
+        "Grains/Placement/Shape = file reads: a packing one run prepares is "
+        "the initial state of the next.");
+      prm.declare_entry(
         "Format",
         "vtu",
         Selection("vtu|hdf5"),
@@ -142,7 +151,8 @@ namespace ImmersedGrains
                         "Conditions on statistics columns at the end of the "
                         "run, printed as yes/no in test mode, separated by "
                         "';': 'column < v', 'column > v', 'column in [a, "
-                        "b]'.");
+                        "b]'; max(column) or min(column) for its extreme "
+                        "over the rows the run wrote.");
       prm.declare_entry(
         "Boundary forces",
         "",
@@ -239,7 +249,8 @@ namespace ImmersedGrains
     prm.enter_subsection("Output");
     {
       const InputLocation where{file, "Output"};
-      write_fields_every = prm.get_integer("Write fields every");
+      write_fields_every      = prm.get_integer("Write fields every");
+      write_grain_file_at_end = prm.get_bool("Write grain file");
       output_format =
         prm.get("Format") == "hdf5" ? OutputFormat::hdf5 : OutputFormat::vtu;
       const std::string mode = prm.get("Terminal output");
@@ -651,6 +662,8 @@ namespace ImmersedGrains
         record_timings();
         maybe_write_checkpoint();
       }
+      if (grains && write_grain_file_at_end)
+        write_grain_file(*grains, output_directory + "/grains.txt", time, comm);
     }
     catch (const std::exception &e)
     {

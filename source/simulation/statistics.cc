@@ -195,6 +195,8 @@ namespace ImmersedGrains
       set_grain_statistics();
     statistics.set("wall_time", wall_clock() - wall_start);
     statistics.write_row();
+    for (TestCheck &c : test_checks)
+      c.record(statistics);
 
     print_test_row(false);
     pdetail << "step " << step << " t=" << time << " dt=" << dt;

@@ -13,10 +13,12 @@ namespace ImmersedGrains
   /**
    * A condition on a statistics column at the end of a run, for test mode
    * (`subsection Output / set Test checks`): "column < value",
-   * "column > value" or "column in [a, b]". A test that prints whether its
-   * checks hold, rather than the values, stays meaningful for chaotic
-   * scenes (a pile, a run on several ranks) whose values differ in the last
-   * digits between builds or rank counts.
+   * "column > value" or "column in [a, b]", where column may also be
+   * "max(column)" or "min(column)", its extreme over the rows the run
+   * wrote (a pressure's peak during a collapse, say). A test that prints
+   * whether its checks hold, rather than the values, stays meaningful for
+   * chaotic scenes (a pile, a run on several ranks) whose values differ in the
+   * last digits between builds or rank counts.
    */
   struct TestCheck
   {
@@ -25,6 +27,19 @@ namespace ImmersedGrains
     double      lower;
     double      upper;
     std::string text;
+    /** 0 for the last row's value, else '+' (max) or '-' (min) over the
+     *  rows recorded. */
+    char   extreme = 0;
+    double extreme_value;
+    bool   recorded = false;
+
+    /** Takes the row just written into the extreme. */
+    void
+    record(const Statistics &statistics);
+
+    /** The value the condition is on. */
+    double
+    value(const Statistics &statistics) const;
 
     bool
     holds(const Statistics &statistics) const;
