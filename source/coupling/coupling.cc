@@ -74,7 +74,7 @@ namespace ImmersedGrains
         "at each). false: one grain step per fluid step.");
       prm.declare_entry(
         "Resting threshold",
-        "1e-2",
+        "0.1",
         Double(0),
         "A grain whose speed is at most this fraction of the velocity its "
         "last contact impulse removed (|v| <= f |P| / (m + dt gamma), with "
