@@ -15,10 +15,8 @@ final bed, without the slab on the floor (the floor orders the first
 layer) and the two at its surface.
 """
 import argparse
-import glob
 import math
 import os
-import re
 import sys
 
 import numpy as np
@@ -28,7 +26,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from plot_scene import read_vtu  # noqa: E402
+from plot_scene import particle_states  # noqa: E402
 
 # The scene's column, beads and fluid (prm/batch_settling_3d.prm).
 WIDTH, HEIGHT, RADIUS = 4e-4, 3.2e-3, 12.5e-6
@@ -43,22 +41,8 @@ EXPONENT = 4.8
 
 def states(directory):
     """(time, z of every grain) of every written state of a run."""
-    try:
-        with open(os.path.join(directory, "particles.pvd")) as f:
-            entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"',
-                                 f.read())
-    except OSError:
-        entries = []
-    if not entries:
-        sys.exit("plot_batch_settling.py: no particles.pvd in " + directory)
-    out = []
-    for time, name in entries:
-        base = os.path.join(directory, name)
-        files = [base] if name.endswith(".vtu") else sorted(
-            glob.glob(base.replace(".pvtu", ".*.vtu")))
-        z = np.concatenate([read_vtu(f)[0][:, 2] for f in files])
-        out.append((float(time), z))
-    return out
+    return [(t, x[:, 2]) for t, x in
+            particle_states(directory, "plot_batch_settling.py")]
 
 
 def profile(z):

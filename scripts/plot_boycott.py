@@ -13,10 +13,8 @@ half the initial one (the tank's horizontal width is the same at every
 height, so the strips of both tanks compare).
 """
 import argparse
-import glob
 import math
 import os
-import re
 import sys
 
 import numpy as np
@@ -27,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from plot_scene import read_vtu  # noqa: E402
+from plot_scene import particle_states  # noqa: E402
 
 # The scene's tank and suspension (prm/meshes/boycott_2d.py defaults).
 WIDTH, HEIGHT, RADIUS, STRIP = 1.5e-3, 6e-3, 25e-6, 0.25e-3
@@ -35,18 +33,7 @@ WIDTH, HEIGHT, RADIUS, STRIP = 1.5e-3, 6e-3, 25e-6, 0.25e-3
 
 def states(directory):
     """(time, positions) of every written state of a run."""
-    with open(os.path.join(directory, "particles.pvd")) as f:
-        entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"', f.read())
-    if not entries:
-        sys.exit("plot_boycott.py: no particles.pvd in " + directory)
-    out = []
-    for time, name in entries:
-        base = os.path.join(directory, name)
-        files = [base] if name.endswith(".vtu") else sorted(
-            glob.glob(base.replace(".pvtu", ".*.vtu")))
-        points = np.concatenate([read_vtu(f)[0] for f in files])
-        out.append((float(time), points))
-    return out
+    return particle_states(directory, "plot_boycott.py")
 
 
 def top(points, fraction0):

@@ -75,6 +75,28 @@ def read_vtu(path):
     return points, arrays, cell_names
 
 
+def particle_states(directory, caller):
+    """(time, grain centres) of every state particles.pvd lists in a run's
+    output directory, whatever the number of pieces; @p caller names the
+    script in the message when there is none."""
+    try:
+        with open(os.path.join(directory, "particles.pvd")) as f:
+            entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"',
+                                 f.read())
+    except OSError:
+        entries = []
+    if not entries:
+        sys.exit(caller + ": no particles.pvd in " + directory)
+    out = []
+    for time, name in entries:
+        base = os.path.join(directory, name)
+        files = [base] if name.endswith(".vtu") else sorted(
+            glob.glob(base.replace(".pvtu", ".*.vtu")))
+        out.append((float(time),
+                    np.concatenate([read_vtu(f)[0] for f in files])))
+    return out
+
+
 def pieces(directory, prefix, step):
     files = sorted(glob.glob(os.path.join(directory, prefix + "_*.vtu")))
     steps = sorted({int(re.search(prefix + r"_(\d+)\.", f).group(1))
