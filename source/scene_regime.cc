@@ -2,6 +2,7 @@
 // numbers that decide which physics it needs, and where its choices leave
 // the range the model is validated for (doc/validation.md); and
 // choose_drag_distribution(), which picks the validated one.
+#include <immersed_grains/box_buckets.h>
 #include <immersed_grains/coupling/drag_law.h>
 #include <immersed_grains/parameters.h>
 #include <immersed_grains/simulation.h>
@@ -22,6 +23,52 @@ namespace ImmersedGrains
       std::ostringstream s;
       s << std::setprecision(digits) << x;
       return s.str();
+    }
+
+
+    /**
+     * The mean number of neighbours each grain touches, counting as touching
+     * two grains whose gap is below 5 % of their radii's sum: about 3-4 in a
+     * packing that has settled, below 1 for grains placed at random even at
+     * solid fraction 0.5.
+     */
+    template <int dim>
+    double
+    mean_touching_neighbours(const std::vector<GrainSeed<dim>> &seeds)
+    {
+      if (seeds.size() < 2)
+        return 0;
+      constexpr double                      gap = 0.05;
+      std::vector<dealii::BoundingBox<dim>> boxes;
+      boxes.reserve(seeds.size());
+      dealii::Point<dim> lower = seeds[0].position, upper = lower;
+      double             largest = 0;
+      for (const auto &seed : seeds)
+      {
+        dealii::Point<dim> a = seed.position, b = seed.position;
+        for (unsigned int d = 0; d < dim; ++d)
+        {
+          a[d] -= (1 + gap) * seed.radius;
+          b[d] += (1 + gap) * seed.radius;
+          lower[d] = std::min(lower[d], a[d]);
+          upper[d] = std::max(upper[d], b[d]);
+        }
+        boxes.emplace_back(std::make_pair(a, b));
+        largest = std::max(largest, seed.radius);
+      }
+      BoxBuckets<dim> buckets;
+      buckets.reinit(lower, upper, 2 * (1 + gap) * largest, boxes);
+      std::vector<unsigned int> near;
+      std::size_t               touching = 0;
+      for (unsigned int i = 0; i < seeds.size(); ++i)
+      {
+        buckets.near(seeds[i].position, (1 + gap) * seeds[i].radius, near);
+        for (const unsigned int j : near)
+          if (j != i && seeds[i].position.distance(seeds[j].position) <
+                          (1 + gap) * (seeds[i].radius + seeds[j].radius))
+            ++touching;
+      }
+      return static_cast<double>(touching) / seeds.size();
     }
   } // namespace
 
@@ -236,7 +283,30 @@ namespace ImmersedGrains
         "half the box wide, doc/validation.md, \"Small 2D balls\"); use "
         "Drag distribution = auto (the cell spread, validated on clouds of "
         "321 discs)");
-    if (two_way && dim == 2 && spread_in_cells && !ball_2d &&
+    // A packing screens each disc's disturbance: its filter must keep the
+    // pore pressure, which varies over a few diameters (column_collapse_2d).
+    const bool packed_2d = dim == 2 && touching_neighbours >= 2;
+    if (two_way && packed_2d && spread_in_cells &&
+        grain_parameters.shape != PlacementShape::lattice)
+      regime.warnings.push_back(
+        "2D packed discs (" + number(touching_neighbours, 2) +
+        " touching neighbours each) with Drag distribution = " +
+        coupling_parameters.drag_distribution +
+        ": the coupling is unstable on a packing spread in cells (a "
+        "collapsing column's discs reached 11 m/s within 25 ms, "
+        "doc/validation.md, \"Column collapse in a viscous liquid\"); use "
+        "Drag distribution = auto (a filter of three diameters)");
+    if (two_way && packed_2d && !spread_in_cells && l > 8 * d)
+      regime.warnings.push_back(
+        "2D packed discs (" + number(touching_neighbours, 2) +
+        " touching neighbours each) with a filter of Smoothing length " +
+        number(l) + " m, " + number(l / d, 2) +
+        " diameters: where the packing shears or fails, it spreads the "
+        "pore pressure that holds or lifts it flat (a loose and a dense "
+        "column collapse alike with half the box, "
+        "doc/validation.md, \"Column collapse in a viscous liquid\"); use "
+        "about three diameters, or Drag distribution = auto");
+    if (two_way && dim == 2 && spread_in_cells && !ball_2d && !packed_2d &&
         grain_parameters.shape != PlacementShape::lattice)
       regime.warnings.push_back(
         "2D with Drag distribution = " + coupling_parameters.drag_distribution +
@@ -248,7 +318,7 @@ namespace ImmersedGrains
         "with Smoothing length about half the box (lone discs and 2D "
         "suspensions then lie within 0.5 % of the closure)");
     const double shortest_side = geometry.shortest_side();
-    if (two_way && !spread_in_cells && dim == 2 && !ball_2d &&
+    if (two_way && !spread_in_cells && dim == 2 && !ball_2d && !packed_2d &&
         l < shortest_side / 4)
       regime.warnings.push_back(
         "Smoothing length " + number(l) + " m is " +
@@ -351,6 +421,8 @@ namespace ImmersedGrains
   Simulation<dim>::choose_drag_distribution(const std::string &file)
   {
     auto &c = coupling_parameters;
+    if (dim == 2)
+      touching_neighbours = mean_touching_neighbours(grain_seeds);
     if (c.drag_distribution != "auto")
       return;
     // Where each is validated (doc/validation.md): the cell spread in 3D
@@ -383,9 +455,28 @@ namespace ImmersedGrains
       return;
     c.drag_distribution = "filtered";
     const auto set      = entries_set_in(file);
-    if (c.projection.smoothing_length > 0 &&
-        std::find(set.begin(), set.end(), "Coupling/Smoothing length") !=
-          set.end())
+    const bool given_length =
+      c.projection.smoothing_length > 0 &&
+      std::find(set.begin(), set.end(), "Coupling/Smoothing length") !=
+        set.end();
+    // In a packing each disc's disturbance is screened by the discs it
+    // touches, so the wide filter a free disc needs is not needed; what the
+    // filter must keep is the pore pressure that varies across the packing
+    // over a few diameters, and half the box would spread it flat
+    // (column_collapse_2d: with it, loose and dense columns collapse alike).
+    // Three diameters, as on the packed bed (coupled_packed_bed_2d): shorter
+    // filters pass the packing's bound where cells are finer than the
+    // discs.
+    if (touching_neighbours >= 2 && !given_length)
+    {
+      c.projection.smoothing_length = 6 * mean_grain_radius;
+      drag_distribution_choice =
+        "2D packed discs (" + number(touching_neighbours, 2) +
+        " touching neighbours each): a filter of three mean diameters, " +
+        number(c.projection.smoothing_length) + " m";
+      return;
+    }
+    if (given_length)
     {
       drag_distribution_choice =
         "2D discs not in a cloud, a filter of the Smoothing length given";

@@ -48,10 +48,13 @@ namespace ImmersedGrains
         "(doc/validation.md), with 'filtered' it is set by the length in "
         "metres and does not depend on the mesh. 'auto': 'cell' in 3D; in "
         "2D, two-way coupled, 'cell' for a cloud (a ball placement) and a "
-        "lattice, 'filtered' for other placements (lone discs, random "
-        "suspensions), with 'Smoothing length' half the box's "
-        "shortest side unless set (a disc's own disturbance decays only "
-        "logarithmically, doc/theory.md); the log says which.");
+        "lattice, 'filtered' for other placements: with 'Smoothing length' "
+        "three mean diameters where the placed discs are packed (two or "
+        "more neighbours each within 5 % of touching: the filter must keep "
+        "the pore pressure), half the box's shortest side for lone discs "
+        "and suspensions (a disc's own disturbance decays only "
+        "logarithmically, doc/theory.md), unless the length is set; the "
+        "log says which.");
       prm.declare_entry(
         "Implicit coupling",
         "true",
