@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""A granular column collapsing in a viscous liquid, loose and dense: the
+run-out against time, the excess pore pressure under the column, and the
+column and its deposit, for two runs whose statistics have the probe
+`base` (Output/Probes) and whose particles were written at the release and
+at the end. Prints a table of what it measured. The runs of the test
+column_collapse_2d (doc/validation.md, "Column collapse in a viscous
+liquid"):
+
+    cd build && ctest -R column_collapse_2d && cd ..
+    /usr/bin/python3 scripts/plot_column_collapse.py build/tests/column_collapse_2d.release/loose build/tests/column_collapse_2d.release/dense --out collapse.png
+
+The run-out is (L - L0)/L0, L the largest x a grain's centre reaches
+(statistics column grains_max_x), L0 its value at the release; the column
+stands against the wall at x = 0. The excess pore pressure is the probe
+`base` (statistics column probe_base_pressure, the pressure minus the
+hydrostatic part) in units of the column's buoyant weight per area
+W = (rho_p - rho) g (sum of the discs' areas) / L0.
+"""
+import argparse
+import csv
+import glob
+import math
+import os
+import sys
+
+import numpy as np
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plot_scene import particle_states, read_vtu  # noqa: E402
+
+# The discs and liquid of Rondon et al. (2011), as in column_collapse_2d.
+RHO_P, RHO, G = 2500.0, 1010.0, 9.81
+# Before this the release shears the column's base (both packings).
+TRANSIENT = 0.1
+
+
+def statistics(directory):
+    path = os.path.join(directory, "statistics.csv")
+    try:
+        with open(path) as f:
+            rows = list(csv.DictReader(f))
+    except OSError:
+        sys.exit("plot_column_collapse.py: cannot read " + path)
+    for column in ("time", "grains_max_x", "grains_max_y",
+                   "probe_base_pressure"):
+        if not rows or column not in rows[0]:
+            sys.exit("plot_column_collapse.py: no column %s in %s"
+                     % (column, path))
+    return {k: np.array([float(r[k]) for r in rows]) for k in
+            ("time", "dt", "grains_max_x", "grains_max_y",
+             "probe_base_pressure")}
+
+
+def disc_area(directory):
+    """The discs' total area, from the radii of the first written state."""
+    first = sorted(glob.glob(os.path.join(directory, "particles_00000*.vtu")))
+    if not first:
+        sys.exit("plot_column_collapse.py: no particles_00000*.vtu in "
+                 + directory)
+    return sum(float(np.sum(math.pi * read_vtu(f)[1]["radius"] ** 2))
+               for f in first)
+
+
+def measure(directory):
+    s = statistics(directory)
+    L0, H0 = s["grains_max_x"][0], s["grains_max_y"][0]
+    W = (RHO_P - RHO) * G * disc_area(directory) / L0
+    run_out = (s["grains_max_x"] - L0) / L0
+    excess = s["probe_base_pressure"] / W
+    late = s["time"] > TRANSIENT + 1e-9
+    final = run_out[-1]
+    # When the front first reaches 90 % of its final run-out.
+    t90 = s["time"][np.argmax(run_out >= 0.9 * final)]
+    return dict(
+        s=s, L0=L0, H0=H0, W=W, run_out=run_out, excess=excess,
+        final=final, t90=t90,
+        height=s["grains_max_y"][-1] / H0,
+        mean_excess=float(np.sum(excess[late] * s["dt"][late])
+                          / np.sum(s["dt"][late])),
+        lowest=float(excess.min()), highest=float(excess.max()),
+        states=particle_states(directory, "plot_column_collapse.py"))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("loose")
+    parser.add_argument("dense")
+    parser.add_argument("--out", default="column_collapse_2d.png")
+    args = parser.parse_args()
+    runs = {"loose": measure(args.loose), "dense": measure(args.dense)}
+    colours = {"loose": "tab:orange", "dense": "tab:blue"}
+
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7.5))
+    ax_run, ax_p = axes[0]
+    right = max(r["states"][-1][1][:, 0].max() for r in runs.values())
+    top = max(r["states"][0][1][:, 1].max() for r in runs.values())
+    for (name, r), ax_dep in zip(runs.items(), axes[1]):
+        t = r["s"]["time"]
+        ax_run.plot(t, r["run_out"], color=colours[name], label=name)
+        ax_p.plot(t, r["excess"], color=colours[name], lw=0.8, label=name)
+        for k, (time, points) in enumerate((r["states"][0],
+                                            r["states"][-1])):
+            ax_dep.plot(points[:, 0] * 1e3, points[:, 1] * 1e3,
+                        ".", ms=1.5, color="0.7" if k == 0 else colours[name],
+                        label="t = %.2f s" % time)
+        ax_dep.set_xlim(0, 1.05e3 * right)
+        ax_dep.set_ylim(0, 1.05e3 * top)
+        ax_dep.set_aspect("equal")
+        ax_dep.set_title(name + ": the column and the deposit")
+        ax_dep.set_xlabel("x [mm]")
+        ax_dep.set_ylabel("y [mm]")
+        ax_dep.legend(markerscale=8, fontsize=8, loc="upper right")
+    ax_run.set_xlabel("t [s]")
+    ax_run.set_ylabel("run-out (L - L0)/L0")
+    ax_run.legend()
+    ax_p.axhline(0, color="k", lw=0.5)
+    ax_p.axvline(TRANSIENT, color="gray", ls=":", lw=0.8)
+    ax_p.set_xlabel("t [s]")
+    ax_p.set_ylabel("excess pore pressure at the base / W")
+    ax_p.legend()
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=110)
+
+    print("| | loose | dense |")
+    print("|---|---|---|")
+    rows = [
+        ("column width L0, height H0 [mm]",
+         lambda r: "%.2f, %.2f" % (r["L0"] * 1e3, r["H0"] * 1e3)),
+        ("buoyant weight per area W [Pa]", lambda r: "%.0f" % r["W"]),
+        ("final run-out (L - L0)/L0", lambda r: "%.2f" % r["final"]),
+        ("time to 90 % of it [s]", lambda r: "%.2f" % r["t90"]),
+        ("final height / H0", lambda r: "%.2f" % r["height"]),
+        ("mean excess pore pressure after %.1f s / W" % TRANSIENT,
+         lambda r: "%+.3f" % r["mean_excess"]),
+        ("lowest, highest excess / W",
+         lambda r: "%+.2f, %+.2f" % (r["lowest"], r["highest"])),
+    ]
+    for label, f in rows:
+        print("| %s | %s | %s |" % (label, f(runs["loose"]),
+                                     f(runs["dense"])))
+    print("dense/loose final run-out: %.2f"
+          % (runs["dense"]["final"] / runs["loose"]["final"]))
+    print("wrote " + args.out)
+
+
+if __name__ == "__main__":
+    main()
