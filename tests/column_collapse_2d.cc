@@ -21,22 +21,27 @@
 // the floor under the column's middle (probe at 2.25 mm, 0.1 mm) and
 // compared with the column's buoyant weight per area
 // W = (rho_p - rho) g phi H (66 Pa for both). Checks, each with the
-// spread of four runs with filters of 0.65, 0.675, 0.676 (the default) and
-// 0.70 mm (doc/validation.md, "Column collapse in a viscous liquid"):
+// spread of five runs: filters of 0.65, 0.675, 0.676 (the default) and
+// 0.70 mm, and the default on two ranks (doc/validation.md, "Column
+// collapse in a viscous liquid"):
 //  - at 0.1 s the loose front has run out (L - L0)/L0 more than twice as
 //    far as the dense one (1.23-1.27 against 0.27-0.28);
 //  - at 0.5 s the loose run-out exceeds the dense one (2.16-2.30 against
-//    1.43-1.46; Rondon et al.: about twice);
-//  - the mean excess over 0.1-0.5 s (after the release's transient) is
-//    positive for the loose column and negative for the dense one, each
-//    by more than 2 % of W (+0.039 to +0.061 W; -0.33 to -0.35 W);
+//    1.43-1.49; Rondon et al.: about twice);
+//  - the mean excess over 0.2-0.5 s is positive for the loose column and
+//    negative for the dense one, each by more than 2 % of W (+0.048 to
+//    +0.111 W; -0.26 to -0.31 W). Before 0.2 s the release shears both
+//    columns' bases and the excess under both is negative (to 0.17 s under
+//    the loose one, doc/validation.md's figure; Polania et al. 2024 measure
+//    the same at the start of immersed collapses); from 0.1 s the loose
+//    mean was +0.018 to +0.061 W, too close to the noise;
 //  - the dense column's most negative excess lies below the loose
-//    column's (-0.67 to -0.69 W; -0.48 to -0.56 W, the loose one in the
+//    column's (-0.67 to -0.69 W; -0.47 to -0.56 W, the loose one in the
 //    first 0.05 s, when the release shears its base).
 // With filters of two diameters, half of six runs (0.44-0.50 mm) see a
 // block of the dense column slide off at 0.15 s and run out farther than
 // the loose one: doc/validation.md says why.
-// Serial only: the two runs take about a minute and a half.
+// The two runs take about a minute and a half, serial or on two ranks.
 #include <deal.II/base/mpi.h>
 
 #include "checkpoint_test_support.h"
@@ -125,7 +130,7 @@ end
       if (std::abs(std::stod(rows[r][t]) - 0.1) < 1e-9)
         c.early_run_out = (std::stod(rows[r][x]) - L0) / L0;
       c.lowest_excess = std::min(c.lowest_excess, std::stod(rows[r][p]));
-      if (std::stod(rows[r][t]) > 0.1 + 1e-9)
+      if (std::stod(rows[r][t]) > 0.2 + 1e-9)
       {
         c.mean_excess += std::stod(rows[r][p]) * std::stod(rows[r][dt]);
         duration += std::stod(rows[r][dt]);
