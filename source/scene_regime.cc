@@ -27,6 +27,13 @@ namespace ImmersedGrains
 
 
     /**
+     * Placed discs that touch this many neighbours each on average, or more,
+     * are a packing (mean_touching_neighbours()).
+     */
+    constexpr double packed_neighbours = 2;
+
+
+    /**
      * The mean number of neighbours each grain touches, counting as touching
      * two grains whose gap is below 5 % of their radii's sum: about 3-4 in a
      * packing that has settled, below 1 for grains placed at random even at
@@ -285,7 +292,7 @@ namespace ImmersedGrains
         "321 discs)");
     // A packing screens each disc's disturbance: its filter must keep the
     // pore pressure, which varies over a few diameters (column_collapse_2d).
-    const bool packed_2d = dim == 2 && touching_neighbours >= 2;
+    const bool packed_2d = dim == 2 && touching_neighbours >= packed_neighbours;
     if (two_way && packed_2d && spread_in_cells &&
         grain_parameters.shape != PlacementShape::lattice)
       regime.warnings.push_back(
@@ -467,7 +474,7 @@ namespace ImmersedGrains
     // Three diameters, as on the packed bed (coupled_packed_bed_2d): shorter
     // filters pass the packing's bound where cells are finer than the
     // discs.
-    if (touching_neighbours >= 2 && !given_length)
+    if (touching_neighbours >= packed_neighbours && !given_length)
     {
       c.projection.smoothing_length = 6 * mean_grain_radius;
       drag_distribution_choice =
