@@ -3,6 +3,9 @@
 export OMPI_ALLOW_RUN_AS_ROOT=1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
+# The machine's cores, for make and ctest: counted before OMP_NUM_THREADS is
+# set below, which GNU nproc would otherwise report.
+export IMMERSED_GRAINS_JOBS=${IMMERSED_GRAINS_JOBS:-$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)}
 # deal.II and Trilinos threads fight with MPI ranks on small machines.
 export DEAL_II_NUM_THREADS=${DEAL_II_NUM_THREADS:-1}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}

@@ -9,5 +9,5 @@ cd build
 # built first, so that two variants running side by side do not both build
 # (and race on) it.
 targets=$(make help | sed -n 's/^\.\.\. \(tests\.[A-Za-z0-9_]*\.release\)$/\1/p')
-[ -z "$targets" ] || cmake --build . -j"$(nproc)" --target $targets
-ctest -j"$(nproc)" --output-on-failure --timeout 1500 "$@"
+[ -z "$targets" ] || cmake --build . -j"$IMMERSED_GRAINS_JOBS" --target $targets
+ctest -j"$IMMERSED_GRAINS_JOBS" --output-on-failure --timeout 1500 "$@"

@@ -21,4 +21,4 @@ fi
 
 source scripts/environment.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$(nproc)"
+cmake --build build -j"$IMMERSED_GRAINS_JOBS"
