@@ -13,6 +13,9 @@
 // clouds: none), the same cloud given the filtered drag (a warning: the
 // filter smooths the ball's collective flow) and 160 discs in a box (a
 // suspension: the filtered drag with a filter half the box wide, none).
+// Grains of two sizes (radii 1:2) under the default law (a warning: a law
+// for one size), under Yin-Sundaresan (none), and radii 1:5 under it (a
+// warning: fitted to diameter ratio 4).
 //
 // The report's figures in e-notation with a negative exponent (a grain's
 // radius, terminal velocity, Reynolds number, ...; the stream writes
@@ -39,7 +42,8 @@ check(const std::string &name,
       const bool         stokes,
       const unsigned int count  = 200,
       const unsigned int dim    = 3,
-      const bool         box_2d = false)
+      const bool         box_2d = false,
+      const std::string &grains = "")
 {
   fs::remove_all("out_" + name);
   {
@@ -69,7 +73,7 @@ check(const std::string &name,
          "  set Enabled = true\n"
          "  set Radius = 12.5e-6\n"
          "  set Density = 2400\n"
-         "  subsection Placement\n"
+      << grains << "  subsection Placement\n"
       << (dim == 3 ? "    set Shape = box\n"
                      "    set Center = 4e-4, 4e-4, 4e-4\n"
                      "    set Size = 6e-4\n" :
@@ -124,4 +128,29 @@ main()
         160,
         2);
   check("suspension_2d", "", false, 160, 2, true);
+  const std::string two_sizes       = "  set Size distribution = classes\n"
+                                      "  set Class fractions = 0.5, 0.5\n";
+  const std::string stokes_filtered = "  set Drag distribution = filtered\n"
+                                      "  set Smoothing length = 2e-4\n";
+  check("two_sizes",
+        stokes_filtered,
+        true,
+        200,
+        3,
+        false,
+        two_sizes + "  set Class radii = 12.5e-6, 25e-6\n");
+  check("two_sizes_yin_sundaresan",
+        stokes_filtered + "  set Drag law = Yin-Sundaresan\n",
+        true,
+        200,
+        3,
+        false,
+        two_sizes + "  set Class radii = 12.5e-6, 25e-6\n");
+  check("sizes_1_to_5_yin_sundaresan",
+        stokes_filtered + "  set Drag law = Yin-Sundaresan\n",
+        true,
+        200,
+        3,
+        false,
+        two_sizes + "  set Class radii = 12.5e-6, 62.5e-6\n");
 }

@@ -172,6 +172,8 @@ namespace ImmersedGrains
                                        drag_distribution == "auto") :
                           (correction == "true" || correction == "yes");
       projection.parse_parameters(prm, file);
+      projection.with_mean_diameter =
+        DragLaw::create(drag_law)->needs_mean_diameter();
     }
     prm.leave_subsection();
   }
@@ -356,6 +358,7 @@ namespace ImmersedGrains
           GrainSample<dim> s;
           s.reference_location = p.get_reference_location();
           s.volume             = grain_volume<dim>(props[layout.radius]);
+          s.diameter           = 2 * props[layout.radius];
           const bool fixed     = grains.is_fixed(p);
           for (unsigned int d = 0; d < dim; ++d)
             s.velocity[d] = fixed ? 0.0 : props[layout.velocity + d];
@@ -371,7 +374,8 @@ namespace ImmersedGrains
   DragInput
   Coupling<dim>::drag_input(const double                  radius,
                             const double                  fluid_fraction,
-                            const dealii::Tensor<1, dim> &slip) const
+                            const dealii::Tensor<1, dim> &slip,
+                            const double                  mean_diameter) const
   {
     return {radius,
             grain_projected_area<dim>(radius),
@@ -379,7 +383,8 @@ namespace ImmersedGrains
             parameters.projection.closure_porosity.of(fluid_fraction),
             slip.norm(),
             density,
-            viscosity};
+            viscosity,
+            mean_diameter};
   }
 
 
@@ -443,13 +448,15 @@ namespace ImmersedGrains
     const unsigned int                                               i,
     const double                  felt_fraction,
     const dealii::Tensor<1, dim> &felt,
+    const double                  mean_diameter,
     const double                  dt,
     const bool                    frozen) const
   {
     const auto  &c = arrays.contact;
     const double r = c.radius[i];
     GrainDrag    drag;
-    DragInput    in        = drag_input(r, felt_fraction, c.velocity[i] - felt);
+    DragInput    in =
+      drag_input(r, felt_fraction, c.velocity[i] - felt, mean_diameter);
     drag.gamma             = drag_law->coefficient(in);
     drag.held              = held(arrays, i, arrays.mass[i] + dt * drag.gamma);
     const auto [phi, self] = undisturbed(cell,
@@ -463,7 +470,7 @@ namespace ImmersedGrains
                                          !arrays.fixed[i] && !drag.held);
     if (phi != felt_fraction || self.norm() > 0)
     {
-      in         = drag_input(r, phi, c.velocity[i] - (felt - self));
+      in = drag_input(r, phi, c.velocity[i] - (felt - self), mean_diameter);
       drag.gamma = drag_law->coefficient(in);
     }
     drag.self     = self;
@@ -555,6 +562,8 @@ namespace ImmersedGrains
                                            velocities_of(fluid_values);
         const std::vector<double> felt_fraction =
           projection->felt_fluid_fraction(cell, references);
+        const std::vector<double> mean_diameter =
+          projection->mean_diameter(cell, references);
         const std::vector<double> scale =
           implicit_velocity ? std::vector<double>() :
                               projection->solid_scale(cell, references);
@@ -569,16 +578,18 @@ namespace ImmersedGrains
           if (!implicit_velocity)
             lagged_force[i] -= (scale.empty() ? 1.0 : scale[k]) * V *
                                fluid_values[k].pressure_gradient;
-          const GrainDrag drag_of_grain = grain_drag(cell,
-                                                     references[k],
-                                                     arrays,
-                                                     i,
-                                                     felt_fraction[k],
-                                                     felt[k],
-                                                     dt,
-                                                     false);
-          gamma[i]                      = drag_of_grain.gamma;
-          const bool held               = drag_of_grain.held;
+          const GrainDrag drag_of_grain =
+            grain_drag(cell,
+                       references[k],
+                       arrays,
+                       i,
+                       felt_fraction[k],
+                       felt[k],
+                       mean_diameter.empty() ? 0.0 : mean_diameter[k],
+                       dt,
+                       false);
+          gamma[i]        = drag_of_grain.gamma;
+          const bool held = drag_of_grain.held;
           if (!predicted_impulse.empty())
           {
             // Grains that collide and part in turn get impulses that flip
@@ -771,6 +782,9 @@ namespace ImmersedGrains
         const std::vector<double> felt_fraction =
           as_predicted ? std::vector<double>() :
                          projection->felt_fluid_fraction(cell, references);
+        const std::vector<double> mean_diameter =
+          as_predicted ? std::vector<double>() :
+                         projection->mean_diameter(cell, references);
         for (unsigned int i = first; i < end; ++i)
         {
           const unsigned int k    = i - first;
@@ -811,8 +825,16 @@ namespace ImmersedGrains
           const double V = grain_volume<dim>(c.radius[i]);
           if (!as_predicted)
           {
-            const GrainDrag drag_of_grain = grain_drag(
-              cell, references[k], arrays, i, felt_fraction[k], u, dt, true);
+            const GrainDrag drag_of_grain =
+              grain_drag(cell,
+                         references[k],
+                         arrays,
+                         i,
+                         felt_fraction[k],
+                         u,
+                         mean_diameter.empty() ? 0.0 : mean_diameter[k],
+                         dt,
+                         true);
             gamma[i]                          = drag_of_grain.gamma;
             const dealii::Tensor<1, dim> self = drag_of_grain.self;
             arrays.drag_velocity[i] -= self;

@@ -5,6 +5,9 @@
 
 #include <immersed_grains/coupling/solid_fraction.h>
 
+#include <algorithm>
+#include <limits>
+
 namespace ImmersedGrains
 {
   template <int dim>
@@ -86,6 +89,12 @@ namespace ImmersedGrains
       felt = filter.make_ghosted_vector();
     for (auto &f : flux)
       f = filter.make_ghosted_vector();
+    if (parameters.with_mean_diameter)
+    {
+      surface = filter.make_ghosted_vector();
+      if (parameters.smoothing_length > 0)
+        felt_surface = filter.make_ghosted_vector();
+    }
   }
 
 
@@ -97,7 +106,10 @@ namespace ImmersedGrains
            std::vector<GrainSample<dim>> &)> &samples,
     const bool                                with_flux)
   {
-    auto volume_rhs = filter.make_owned_vector();
+    auto volume_rhs  = filter.make_owned_vector();
+    auto surface_rhs = parameters.with_mean_diameter ?
+                         filter.make_owned_vector() :
+                         typename HelmholtzFilter<dim>::Vector();
     std::array<typename HelmholtzFilter<dim>::Vector, dim> flux_rhs;
     for (auto &f : flux_rhs)
       f = filter.make_owned_vector();
@@ -106,8 +118,9 @@ namespace ImmersedGrains
     const unsigned int                           n  = fe.n_dofs_per_cell();
     std::vector<dealii::types::global_dof_index> indices(n);
     std::vector<GrainSample<dim>>                grains;
-    dealii::Vector<double>                       cell_volume(n);
-    std::array<dealii::Vector<double>, dim>      cell_flux;
+    dealii::Vector<double> cell_volume(n), cell_surface(n);
+    double smallest = std::numeric_limits<double>::max(), largest = 0;
+    std::array<dealii::Vector<double>, dim> cell_flux;
     for (auto &c : cell_flux)
       c.reinit(n);
 
@@ -118,18 +131,29 @@ namespace ImmersedGrains
         samples(cell, grains);
         if (grains.empty())
           continue;
-        cell_volume = 0;
+        cell_volume  = 0;
+        cell_surface = 0;
         for (auto &c : cell_flux)
           c = 0;
         for (const auto &g : grains)
+        {
           for (unsigned int j = 0; j < n; ++j)
           {
             const double N = fe.shape_value(j, g.reference_location);
             cell_volume(j) += g.volume * N;
+            cell_surface(j) += g.volume / g.diameter * N;
             for (unsigned int d = 0; d < dim; ++d)
               cell_flux[d](j) += g.volume * g.velocity[d] * N;
           }
+          smallest = std::min(smallest, g.diameter);
+          largest  = std::max(largest, g.diameter);
+        }
         filter.add_cell_contribution(cell, cell_volume, indices, volume_rhs);
+        if (parameters.with_mean_diameter)
+          filter.add_cell_contribution(cell,
+                                       cell_surface,
+                                       indices,
+                                       surface_rhs);
         for (unsigned int d = 0; d < dim; ++d)
           filter.add_cell_contribution(cell,
                                        cell_flux[d],
@@ -137,6 +161,13 @@ namespace ImmersedGrains
                                        flux_rhs[d]);
       }
     volume_rhs.compress(dealii::VectorOperation::add);
+    if (parameters.with_mean_diameter)
+    {
+      surface_rhs.compress(dealii::VectorOperation::add);
+      const MPI_Comm comm = filter.get_dof_handler().get_communicator();
+      smallest_diameter   = dealii::Utilities::MPI::min(smallest, comm);
+      largest_diameter    = dealii::Utilities::MPI::max(largest, comm);
+    }
     for (auto &f : flux_rhs)
       f.compress(dealii::VectorOperation::add);
 
@@ -150,6 +181,15 @@ namespace ImmersedGrains
       }
       else
         flux[d] = 0;
+    // The surface only where the grains differ in size: with one size the
+    // mean is that size (mean_diameter()).
+    const bool with_surface =
+      parameters.with_mean_diameter && largest_diameter > smallest_diameter;
+    if (with_surface)
+    {
+      rhs.push_back(&surface_rhs);
+      fields.push_back(&surface);
+    }
     filter.solve(rhs, fields);
 
     if (parameters.smoothing_length > 0)
@@ -158,6 +198,11 @@ namespace ImmersedGrains
       auto felt_rhs = filter.make_owned_vector();
       filter.mass_product(fraction, felt_rhs);
       filter.solve(felt_rhs, felt);
+      if (with_surface)
+      {
+        filter.mass_product(surface, felt_rhs);
+        filter.solve(felt_rhs, felt_surface);
+      }
     }
 
     unsigned int local_clamped = 0;
@@ -327,6 +372,46 @@ namespace ImmersedGrains
         phi_s += field[indices[i]] * filter.get_fe().shape_value(i, x);
       result.push_back(
         std::clamp(1 - phi_s, parameters.fluid_fraction_bound(), 1.0));
+    }
+    return result;
+  }
+
+
+  template <int dim>
+  std::vector<double>
+  SolidFraction<dim>::mean_diameter(
+    const typename dealii::Triangulation<dim>::active_cell_iterator &tria_cell,
+    const std::vector<dealii::Point<dim>> &reference_points) const
+  {
+    if (!parameters.with_mean_diameter)
+      return {};
+    if (!(largest_diameter > smallest_diameter))
+      return std::vector<double>(reference_points.size(), largest_diameter);
+    const auto         cell = filter.dof_cell(tria_cell);
+    const unsigned int n    = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::types::global_dof_index> indices(n);
+    cell->get_dof_indices(indices);
+    const bool          smoothed = parameters.smoothing_length > 0;
+    const auto         &volume   = smoothed ? felt : fraction;
+    const auto         &area     = smoothed ? felt_surface : surface;
+    std::vector<double> result;
+    for (const auto &x : reference_points)
+    {
+      double v = 0, a = 0;
+      for (unsigned int i = 0; i < n; ++i)
+      {
+        const double N = filter.get_fe().shape_value(i, x);
+        v += volume[indices[i]] * N;
+        a += area[indices[i]] * N;
+      }
+      // v / a lies within the diameters wherever both are positive sums of
+      // the same grains; a consistent projection undershoots below zero
+      // next to a cloud, where the ratio means nothing: 0 there, the
+      // grain's own diameter (DragInput::mean_diameter).
+      result.push_back(
+        v > 0 && a > 0 ?
+          std::clamp(v / a, smallest_diameter, largest_diameter) :
+          0.0);
     }
     return result;
   }

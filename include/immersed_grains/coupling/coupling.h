@@ -230,11 +230,13 @@ namespace ImmersedGrains
     solid_scale() const;
 
     /// What the drag law needs of a grain of @p radius, at the fluid
-    /// fraction @p fluid_fraction (read as Closure porosity in 2D says).
+    /// fraction @p fluid_fraction (read as Closure porosity in 2D says),
+    /// among grains of Sauter mean diameter @p mean_diameter (0: its own).
     DragInput
     drag_input(double                        radius,
                double                        fluid_fraction,
-               const dealii::Tensor<1, dim> &slip) const;
+               const dealii::Tensor<1, dim> &slip,
+               double                        mean_diameter) const;
 
     /// The fluid fraction a free grain's drag law reads, without its own
     /// share of the solid fraction, and its own disturbance of the velocity
@@ -278,6 +280,7 @@ namespace ImmersedGrains
       unsigned int                  i,
       double                        felt_fraction,
       const dealii::Tensor<1, dim> &felt,
+      double                        mean_diameter,
       double                        dt,
       bool                          frozen) const;
 

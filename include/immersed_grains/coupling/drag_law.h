@@ -23,6 +23,10 @@ namespace ImmersedGrains
     double slip_speed;     // |w| = |v_i - u_f(x_i)|
     double density;        // fluid
     double viscosity;      // fluid
+    // The Sauter mean diameter of the grains around this one, sum V / sum
+    // (V / d) over the solid fraction's kernel; 0: the grain's own (only
+    // laws that say needs_mean_diameter() get it).
+    double mean_diameter = 0;
   };
 
   /**
@@ -43,6 +47,17 @@ namespace ImmersedGrains
     /** gamma such that the drag force on the grain is gamma * w. */
     virtual double
     coefficient(const DragInput &input) const = 0;
+
+    /**
+     * Whether the law reads DragInput::mean_diameter: a polydisperse law,
+     * for which the coupling projects the grains' surface as a field beside
+     * their volume.
+     */
+    virtual bool
+    needs_mean_diameter() const
+    {
+      return false;
+    }
 
     /** Particle Reynolds number 2 r rho |w| phi / mu (the seed's
      *  definition, Constant et al. 2019; doc/references.md). */

@@ -24,6 +24,7 @@ namespace ImmersedGrains
   {
     dealii::Point<dim>     reference_location; // in its cell
     double                 volume;
+    double                 diameter;
     dealii::Tensor<1, dim> velocity;
   };
 
@@ -64,6 +65,9 @@ namespace ImmersedGrains
       double          smoothing_length   = 0;
       double          min_fluid_fraction = 0.3; // of the closure's porosity
       ClosurePorosity closure_porosity;
+      // Whether to project the grains' surface too, for mean_diameter():
+      // set by the coupling when its drag law reads it.
+      bool with_mean_diameter = false;
     };
 
     SolidFraction(
@@ -145,6 +149,22 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const std::vector<dealii::Point<dim>> &reference_points) const;
 
+    /**
+     * The Sauter mean diameter of the grains around points of a cell,
+     * sum V_i / sum (V_i / d_i) through the same kernel as the felt
+     * fraction: the ratio of the volume field to the surface field
+     * sum (V_i / d_i) N_j, projected (and filtered) alike. Kept within the
+     * smallest and largest grain diameter (where both fields are small, at
+     * the edge of a cloud, the ratio of two small numbers is not a mean;
+     * 0 where either is not positive); exactly that diameter when all
+     * grains have one. Empty unless
+     * Parameters::with_mean_diameter.
+     */
+    std::vector<double>
+    mean_diameter(
+      const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
+      const std::vector<dealii::Point<dim>> &reference_points) const;
+
     const dealii::DoFHandler<dim> &
     get_dof_handler() const;
 
@@ -172,7 +192,11 @@ namespace ImmersedGrains
     typename HelmholtzFilter<dim>::Vector                  fraction;
     typename HelmholtzFilter<dim>::Vector                  felt; // smoothing
     std::array<typename HelmholtzFilter<dim>::Vector, dim> flux;
-    unsigned int                                           clamped = 0;
+    // With_mean_diameter: sum (V_i / d_i) N_j projected, and filtered once
+    // more like felt; the grains' smallest and largest diameter.
+    typename HelmholtzFilter<dim>::Vector surface, felt_surface;
+    double       smallest_diameter = 0, largest_diameter = 0;
+    unsigned int clamped = 0;
   };
 } // namespace ImmersedGrains
 

@@ -6,31 +6,40 @@
 //                             / (1 + 10^{3 s} Re^{-(1 + 4 s)/2}),
 // s = 1 - phi, Re = phi rho d |w| / mu. The last term is rewritten with
 // Re^{(1+4s)/2} multiplied through so that Re -> 0 is finite.
+#include <immersed_grains/coupling/beetstra_drag.h>
 #include <immersed_grains/coupling/drag_law.h>
 
 #include <cmath>
 
 namespace ImmersedGrains
 {
+  double
+  beetstra_normalised_drag(const double phi, const double re)
+  {
+    const double s = 1 - phi;
+    const double p = 0.5 * (1 + 4 * s);
+    const double a = 1 / phi + 3 * s * phi;
+    const double inertial =
+      0.413 / (24 * phi * phi) *
+      (a * std::pow(re, 1 + p) + 8.4 * std::pow(re, 0.657 + p)) /
+      (std::pow(re, p) + std::pow(10.0, 3 * s));
+    return 10 * s / (phi * phi) + phi * phi * (1 + 1.5 * std::sqrt(s)) +
+           inertial;
+  }
+
+
   class Beetstra : public DragLaw
   {
   public:
     double
     coefficient(const DragInput &in) const override
     {
-      const double phi = in.fluid_fraction, s = 1 - phi;
+      const double phi = in.fluid_fraction;
       const double re =
         phi * in.density * 2 * in.radius * in.slip_speed / in.viscosity;
-      const double p = 0.5 * (1 + 4 * s);
-      const double a = 1 / phi + 3 * s * phi;
-      const double inertial =
-        0.413 / (24 * phi * phi) *
-        (a * std::pow(re, 1 + p) + 8.4 * std::pow(re, 0.657 + p)) /
-        (std::pow(re, p) + std::pow(10.0, 3 * s));
-      const double f =
-        10 * s / (phi * phi) + phi * phi * (1 + 1.5 * std::sqrt(s)) + inertial;
       // 3 pi mu d = 6 mu A / r in 3D; the same expression per unit depth in 2D.
-      return 6 * in.viscosity * in.area / in.radius * phi * f;
+      return 6 * in.viscosity * in.area / in.radius * phi *
+             beetstra_normalised_drag(phi, re);
     }
   };
 } // namespace ImmersedGrains
