@@ -441,8 +441,11 @@ def print_clusters(directory, times, link, core):
         read = [read_vtu(p) for p in pieces]
         x = np.concatenate([r[0] for r in read])
         radius = np.concatenate([r[1]["radius"] for r in read])
-        label = clusters_of(x[:, :3 if VERTICAL == "z" else 2],
-                            2 * radius.max(), link, core)
+        # Links in diameters of the grain of mean volume, as the run's
+        # own cloud analysis measures them.
+        dim = 3 if VERTICAL == "z" else 2
+        diameter = 2 * np.mean(radius ** dim) ** (1 / dim)
+        label = clusters_of(x[:, :dim], diameter, link, core)
         sizes = np.bincount(label[label >= 0])
         order = np.argsort(-sizes)
         large = [int(sizes[k]) for k in order if sizes[k] >= 0.2 * len(x)]

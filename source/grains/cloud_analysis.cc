@@ -6,6 +6,8 @@
 #include <immersed_grains/parameters.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <unordered_map>
 
@@ -32,7 +34,7 @@ namespace ImmersedGrains
                         "3",
                         Double(0),
                         "Two grains whose centres are closer than this many "
-                        "diameters of the largest grain belong to the same "
+                        "diameters of the grain of mean volume belong to the same "
                         "cluster (the mean spacing of a cloud at solid "
                         "fraction 0.2 is about 2 diameters in 2D, 1.4 in 3D).");
       prm.declare_entry(
@@ -211,12 +213,11 @@ namespace ImmersedGrains
   CloudMeasures<dim>
   CloudAnalysis<dim>::analyse(
     const dealii::Particles::ParticleHandler<dim> &particles,
-    const GrainPropertyLayout                     &layout,
-    const double                                   max_diameter) const
+    const GrainPropertyLayout                     &layout) const
   {
     // Every rank gets all grains, ordered by id: the clusters and the sums
     // are then the same on any number of ranks.
-    const unsigned int  record = 1 + 2 * dim;
+    const unsigned int  record = 2 + 2 * dim;
     std::vector<double> local;
     local.reserve(particles.n_locally_owned_particles() * record);
     for (const auto &p : particles)
@@ -227,6 +228,7 @@ namespace ImmersedGrains
       const auto props = p.get_properties();
       for (unsigned int d = 0; d < dim; ++d)
         local.push_back(props[layout.velocity + d]);
+      local.push_back(props[layout.radius]);
     }
     std::vector<double> all;
     for (const auto &part : dealii::Utilities::MPI::all_gather(comm, local))
@@ -240,19 +242,31 @@ namespace ImmersedGrains
               { return all[a * record] < all[b * record]; });
     std::vector<dealii::Point<dim>>     x(n);
     std::vector<dealii::Tensor<1, dim>> v(n);
+    double smallest = std::numeric_limits<double>::max(), largest = 0,
+           sum_of_powers = 0;
     for (unsigned int i = 0; i < n; ++i)
+    {
       for (unsigned int d = 0; d < dim; ++d)
       {
         x[i][d] = all[order[i] * record + 1 + d];
         v[i][d] = all[order[i] * record + 1 + dim + d];
       }
+      const double r = all[order[i] * record + 1 + 2 * dim];
+      smallest       = std::min(smallest, r);
+      largest        = std::max(largest, r);
+      sum_of_powers += dealii::Utilities::fixed_power<dim>(r);
+    }
 
     CloudMeasures<dim> m;
     if (n == 0)
       return m;
+    // One size: that diameter exactly.
+    const double diameter =
+      largest == smallest ? 2 * largest :
+                            2 * std::pow(sum_of_powers / n, 1.0 / dim);
     const std::vector<unsigned int> label =
       label_clusters(x,
-                     parameters.link_distance * max_diameter,
+                     parameters.link_distance * diameter,
                      parameters.core_neighbours);
     const unsigned int n_labels =
       *std::max_element(label.begin(), label.end()) + 1;

@@ -278,9 +278,7 @@ namespace ImmersedGrains
   Simulation<dim>::set_cloud_statistics()
   {
     const CloudMeasures<dim> m =
-      cloud_analysis->analyse(grains->particle_handler(),
-                              grains->layout(),
-                              2 * largest_grain_radius);
+      cloud_analysis->analyse(grains->particle_handler(), grains->layout());
     const char *axes[] = {"x", "y", "z"};
     statistics.set("cloud_grains", m.n_cloud_grains);
     for (unsigned int d = 0; d < dim; ++d)
