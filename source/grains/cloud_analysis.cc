@@ -30,13 +30,14 @@ namespace ImmersedGrains
         "(statistics.csv columns cloud_*, leaked, clusters, "
         "breakup_time; doc/theory.md). auto: on when the grains are placed "
         "as a ball (Grains/Placement/Shape = ball).");
-      prm.declare_entry("Link distance",
-                        "3",
-                        Double(0),
-                        "Two grains whose centres are closer than this many "
-                        "diameters of the grain of mean volume belong to the same "
-                        "cluster (the mean spacing of a cloud at solid "
-                        "fraction 0.2 is about 2 diameters in 2D, 1.4 in 3D).");
+      prm.declare_entry(
+        "Link distance",
+        "3",
+        Double(0),
+        "Two grains whose centres are closer than this many "
+        "diameters of the grain of mean volume belong to the same "
+        "cluster (the mean spacing of a cloud at solid "
+        "fraction 0.2 is about 2 diameters in 2D, 1.4 in 3D).");
       prm.declare_entry(
         "Core neighbours",
         "4",
@@ -261,9 +262,9 @@ namespace ImmersedGrains
     if (n == 0)
       return m;
     // One size: that diameter exactly.
-    const double diameter =
-      largest == smallest ? 2 * largest :
-                            2 * std::pow(sum_of_powers / n, 1.0 / dim);
+    const double                    diameter = largest == smallest ?
+                                                 2 * largest :
+                                                 2 * std::pow(sum_of_powers / n, 1.0 / dim);
     const std::vector<unsigned int> label =
       label_clusters(x,
                      parameters.link_distance * diameter,
