@@ -70,7 +70,7 @@ main(int argc, char **argv)
         const auto found =
           GridTools::find_active_cell_around_point(mapping, tria, p);
         by_cell[found.first].push_back(
-          {found.second, volume, Tensor<1, dim>()});
+          {found.second, volume, 2 * r, Tensor<1, dim>()});
       }
       projection.project(
         [&](const auto &cell, std::vector<GrainSample<dim>> &samples)

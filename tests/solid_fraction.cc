@@ -69,7 +69,7 @@ check(const bool lumped, const double smoothing)
       if (found.first.state() == IteratorState::valid &&
           found.first->is_locally_owned())
         by_cell[found.first].push_back(
-          {found.second, volume, Tensor<1, dim>()});
+          {found.second, volume, 2 * r, Tensor<1, dim>()});
     }
     projection.project(
       [&](const auto &cell, std::vector<GrainSample<dim>> &grains)
