@@ -2,6 +2,8 @@
 #include <immersed_grains/coupling/coupling.h>
 #include <immersed_grains/io/statistics.h>
 
+#include <sstream>
+
 namespace ImmersedGrains
 {
   template <int dim>
@@ -26,6 +28,27 @@ namespace ImmersedGrains
   {
     CoupledStepReport<dim> report;
     grains.gather();
+    // Grains that the last steps sped up beyond what one fluid step can
+    // follow (the sub-steps below keep each within an eighth of the
+    // smallest radius): the step fails before anything has changed, so
+    // that it can be taken again shorter, as a fluid step that fails.
+    if (coupling.grain_substeps())
+    {
+      const unsigned int needed = grains.substeps(dt);
+      if (needed > coupling.max_grain_substeps())
+      {
+        std::ostringstream message;
+        message << "the grains would need " << needed
+                << " grain sub-steps in this fluid step of " << dt
+                << " s, over Coupling/Maximum grain sub-steps = "
+                << coupling.max_grain_substeps()
+                << ": their speeds have outgrown the step (a coupling grown "
+                   "unstable at a step too long, doc/stability.md). A "
+                   "shorter Time step, or Adaptive time step = true, which "
+                   "takes such a step again with half its length.";
+        throw FluidStepFailure(message.str());
+      }
+    }
     coupling.project(grains);
     // Grains packed beyond 1 - Minimum fluid fraction: the fluid sees the
     // minimum there. Said when it starts, counted every step.

@@ -76,6 +76,18 @@ namespace ImmersedGrains
         "coefficient re-evaluated where they are at each (contacts solved "
         "at each). false: one grain step per fluid step.");
       prm.declare_entry(
+        "Maximum grain sub-steps",
+        "1000",
+        Integer(1),
+        "The most grain sub-steps one fluid step may take. A step that would "
+        "need more (its fastest grain would cross more than 125 of the "
+        "smallest radii in the fluid of that step) has lost the coupling: "
+        "grains far faster than anything the scene drives, typically a "
+        "coupling grown unstable at a step too long. It is taken again with "
+        "half its length (Adaptive time step = true, up to Step retries "
+        "times), else the run stops with a message, instead of crawling "
+        "through thousands of sub-steps per step (doc/stability.md).");
+      prm.declare_entry(
         "Resting threshold",
         "0.1",
         Double(0),
@@ -155,6 +167,7 @@ namespace ImmersedGrains
       drag_distribution         = prm.get("Drag distribution");
       implicit_coupling         = prm.get_bool("Implicit coupling");
       grain_substeps            = prm.get_bool("Grain sub-steps");
+      max_grain_substeps        = prm.get_integer("Maximum grain sub-steps");
       resting_threshold         = prm.get_double("Resting threshold");
       impulse_prediction_weight = prm.get_double("Impulse prediction weight");
       repay_drag_mismatch       = prm.get_bool("Repay drag mismatch");

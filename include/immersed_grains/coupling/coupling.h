@@ -66,16 +66,17 @@ namespace ImmersedGrains
       void
       parse_parameters(dealii::ParameterHandler &prm, const std::string &file);
 
-      std::string drag_law                  = "Dallavalle-Wen-Yu";
-      bool        two_way                   = true;
-      bool        tracers                   = false;
-      std::string drag_distribution         = "cell";
-      bool        implicit_coupling         = true;
-      bool        grain_substeps            = true;
-      double      resting_threshold         = 1e-3;
-      double      impulse_prediction_weight = 1. / 3;
-      bool        repay_drag_mismatch       = true;
-      bool        self_correction           = false;
+      std::string  drag_law                  = "Dallavalle-Wen-Yu";
+      bool         two_way                   = true;
+      bool         tracers                   = false;
+      std::string  drag_distribution         = "cell";
+      bool         implicit_coupling         = true;
+      bool         grain_substeps            = true;
+      unsigned int max_grain_substeps        = 1000;
+      double       resting_threshold         = 1e-3;
+      double       impulse_prediction_weight = 1. / 3;
+      bool         repay_drag_mismatch       = true;
+      bool         self_correction           = false;
       typename SolidFraction<dim>::Parameters projection;
     };
 
@@ -128,6 +129,13 @@ namespace ImmersedGrains
     grain_substeps() const
     {
       return parameters.grain_substeps;
+    }
+
+    /** Coupling/Maximum grain sub-steps. */
+    unsigned int
+    max_grain_substeps() const
+    {
+      return parameters.max_grain_substeps;
     }
 
     void
