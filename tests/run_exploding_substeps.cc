@@ -4,10 +4,7 @@
 // 2500 kg/m^3) thrown at 1 m/s into a viscous liquid (0.1 Pa s) in a
 // 1 cm box, in fluid steps of 0.1 s: its sub-steps of an eighth of its
 // radius need 1 / (1.25e-5 / 0.1) = 8000 of them in the first step, over
-// the default bound of 1000. (A collapsing tall dense column whose
-// coupling turned unstable at a step too long grew from 14 to 632
-// sub-steps per fluid step within five steps, its grains at 1.25 m/s,
-// and the run crawled instead of stopping, doc/stability.md.)
+// the default bound of 1000.
 // With a fixed step: one line on stderr naming the step, the sub-steps
 // and the bound, a non-zero exit status. With Maximum grain sub-steps =
 // 10000 the same run goes on (the disc stops within its relaxation time,

@@ -82,7 +82,7 @@ namespace ImmersedGrains
         "The most grain sub-steps one fluid step may take. A step that would "
         "need more (its fastest grain would cross more than 125 of the "
         "smallest radii in the fluid of that step) has lost the coupling: "
-        "grains far faster than anything the scene drives, typically a "
+        "grains far faster than the fluid step can follow, typically a "
         "coupling grown unstable at a step too long. It is taken again with "
         "half its length (Adaptive time step = true, up to Step retries "
         "times), else the run stops with a message, instead of crawling "
