@@ -137,11 +137,14 @@ namespace ImmersedGrains
           c = 0;
         for (const auto &g : grains)
         {
+          // Only a law that reads the mean diameter pays for its field.
+          const double surface =
+            parameters.with_mean_diameter ? g.volume / g.diameter : 0.0;
           for (unsigned int j = 0; j < n; ++j)
           {
             const double N = fe.shape_value(j, g.reference_location);
             cell_volume(j) += g.volume * N;
-            cell_surface(j) += g.volume / g.diameter * N;
+            cell_surface(j) += surface * N;
             for (unsigned int d = 0; d < dim; ++d)
               cell_flux[d](j) += g.volume * g.velocity[d] * N;
           }
