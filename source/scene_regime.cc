@@ -397,8 +397,9 @@ namespace ImmersedGrains
         largest  = std::max(largest, seed.radius);
       }
       const double ratio = largest / smallest;
-      const bool   polydisperse_law =
-        DragLaw::create(coupling_parameters.drag_law)->needs_mean_diameter();
+      // Set from the law when the parameters were read.
+      const bool polydisperse_law =
+        coupling_parameters.projection.with_mean_diameter;
       if (ratio >= 1.5 && !polydisperse_law)
         regime.warnings.push_back(
           "grains of diameter ratio " + number(ratio, 2) +
