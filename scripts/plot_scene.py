@@ -75,10 +75,11 @@ def read_vtu(path):
     return points, arrays, cell_names
 
 
-def particle_states(directory, caller):
+def particle_states(directory, caller, names=()):
     """(time, grain centres) of every state particles.pvd lists in a run's
-    output directory, whatever the number of pieces; @p caller names the
-    script in the message when there is none."""
+    output directory, whatever the number of pieces; with @p names, (time,
+    centres, {name: values}) with those particle fields (e.g. "radius").
+    @p caller names the script in the message when there is none."""
     try:
         with open(os.path.join(directory, "particles.pvd")) as f:
             entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"',
@@ -92,8 +93,18 @@ def particle_states(directory, caller):
         base = os.path.join(directory, name)
         files = [base] if name.endswith(".vtu") else sorted(
             glob.glob(base.replace(".pvtu", ".*.vtu")))
-        out.append((float(time),
-                    np.concatenate([read_vtu(f)[0] for f in files])))
+        pieces_read = [read_vtu(f) for f in files]
+        centres = np.concatenate([p[0] for p in pieces_read])
+        if not names:
+            out.append((float(time), centres))
+            continue
+        missing = [n for n in names if n not in pieces_read[0][1]]
+        if missing:
+            sys.exit("%s: no particle field %s in %s" %
+                     (caller, ", ".join(missing), files[0]))
+        out.append((float(time), centres,
+                    {n: np.concatenate([p[1][n] for p in pieces_read])
+                     for n in names}))
     return out
 
 

@@ -319,7 +319,9 @@ namespace ImmersedGrains
           "a solve takes more than this many times the iterations of the "
           "first solve after the last rebuild (plus 3), when the mass "
           "coefficient rho a0/dt changes by more than 25%, when a solve "
-          "fails, or after a mesh change. 0: rebuilt before every solve "
+          "fails (with the kept preconditioner: once it needs three times "
+          "the iterations that would ask for a rebuild, at least 30), or "
+          "after a mesh change. 0: rebuilt before every solve "
           "(doc/performance.md).");
       }
       prm.leave_subsection();
