@@ -52,14 +52,17 @@ def profile(z):
     return counts * (4 / 3 * math.pi * RADIUS ** 3) / (WIDTH ** 2 * SLAB)
 
 
-def top(fraction, phi0):
+def top(fraction, phi0, slab=SLAB):
+    """The upper edge of the highest slab at half of phi0 or more."""
     dense = np.nonzero(fraction >= 0.5 * phi0)[0]
-    return (dense[-1] + 1) * SLAB if len(dense) else 0.0
+    return (dense[-1] + 1) * slab if len(dense) else 0.0
 
 
-def bed(fraction, phi0, phi_bed):
+def bed(fraction, phi0, phi_bed, slab=SLAB, height=HEIGHT):
+    """The lower edge of the lowest slab below half-way between phi0 and
+    the bed's packing."""
     loose = np.nonzero(fraction < 0.5 * (phi0 + phi_bed))[0]
-    return loose[0] * SLAB if len(loose) else HEIGHT
+    return loose[0] * slab if len(loose) else height
 
 
 def flux(phi):

@@ -33,6 +33,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plot_batch_settling import bed, fit_speed, top  # noqa: E402
 from plot_scene import particle_states  # noqa: E402
 
 # The scene's column, beads and fluid (prm/batch_settling_two_sizes_3d.prm).
@@ -123,21 +124,6 @@ def profiles(z, r, radii, slab, height):
     return out
 
 
-def top_of(fraction, phi0, slab):
-    dense = np.nonzero(fraction >= 0.5 * phi0)[0]
-    return (dense[-1] + 1) * slab if len(dense) else 0.0
-
-
-def bed_of(total, phi0, phi_bed, slab, height):
-    loose = np.nonzero(total < 0.5 * (phi0 + phi_bed))[0]
-    return loose[0] * slab if len(loose) else height
-
-
-def fit_speed(t, h, mask):
-    return -np.polyfit(t[mask], h[mask], 1)[0] if mask.sum() > 2 \
-        else float("nan")
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("run")
@@ -165,13 +151,13 @@ def main():
     # The bed's packing: the final bed's slabs without the floor's and the
     # two at its surface.
     final = totals[-1]
-    surface = top_of(final, phi0, slab)
+    surface = top(final, phi0, slab)
     inside = np.arange(len(final))[1:max(2, int(round(surface / slab)) - 2)]
     phi_bed = float(final[inside].mean())
 
-    tops = np.array([top_of(p[0], phis[0], slab) for p in per_class])
-    mixtures = np.array([top_of(p[1], phis[1], slab) for p in per_class])
-    beds = np.array([bed_of(t, phi0, phi_bed, slab, height) for t in totals])
+    tops = np.array([top(p[0], phis[0], slab) for p in per_class])
+    mixtures = np.array([top(p[1], phis[1], slab) for p in per_class])
+    beds = np.array([bed(t, phi0, phi_bed, slab, height) for t in totals])
 
     # Predictions.
     law = drag_law(args.run)
