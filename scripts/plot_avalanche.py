@@ -15,7 +15,8 @@ excess pore pressure is the probe under the layer, in units of the
 layer's buoyant weight per area normal to the slope,
 W = (rho_p - rho) g cos(theta) phi H. The layer fails when its velocity,
 averaged over the last 0.1 s, first exceeds 1 mm/s (about ten times the
-dense layer's creep, a tenth of the loose layer's flow); its creep is the
+dense layer's creep, a tenth of the loose layer's flow), from 0.2 s on
+(the release jolts both layers for a step or two); its creep is the
 median velocity from the start to then.
 """
 import argparse
@@ -71,15 +72,17 @@ def main():
         packing = phi0 * lift[0] / lift
         excess = c["probe_base_pressure"] / weight
         # The release jolts both layers for a step or two: the failure is
-        # read on the velocity averaged over the last SMOOTHING seconds.
+        # read on the velocity averaged over the last SMOOTHING seconds,
+        # once that window has left the jolt behind.
         window = max(1, int(round(SMOOTHING / (t[2] - t[1]))))
         smooth = np.convolve(c["layer_velocity"], np.ones(window) / window,
                              mode="full")[:len(t)]
-        failed = np.nonzero((smooth > FAILURE_SPEED) & (t >= SMOOTHING))[0]
+        failed = np.nonzero((smooth > FAILURE_SPEED) &
+                            (t >= 2 * SMOOTHING - 1e-9))[0]
         t_fail = t[failed[0]] if len(failed) else float("nan")
         # A layer that fails within the first window has no creep.
         before = (t > 0) & (t < t_fail) if len(failed) and \
-            t_fail > SMOOTHING else np.zeros_like(t, bool)
+            t_fail > 2 * SMOOTHING + 1e-9 else np.zeros_like(t, bool)
         after = t >= t_fail if len(failed) else np.zeros_like(t, bool)
 
         def mean(values, mask):
