@@ -12,7 +12,7 @@
 // weight, the pore pressure under it rises above hydrostatic, and it
 // flows at once; a dense layer must dilate to flow, draws liquid in, the
 // pore pressure under it falls below hydrostatic and holds it, and it
-// creeps (in the full scene for about 7 s, then it fails). Read over
+// creeps (in the full scene for about 8 s, then it fails). Read over
 // 0.1-0.5 s (after the release's jolt), the excess pressure on the probe
 // 0.25 mm above the base in units of the layer's buoyant weight per area
 // normal to the slope, W = (rho_p - rho) g cos(25) phi H:
