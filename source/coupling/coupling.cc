@@ -238,6 +238,7 @@ namespace ImmersedGrains
     if (filtered_drag)
       filtered_drag->setup();
     filtered_velocity_current = false;
+    sized_cell                = dealii::numbers::invalid_unsigned_int;
   }
 
 
@@ -417,7 +418,12 @@ namespace ImmersedGrains
     if (!parameters.self_correction || !parameters.two_way || !free ||
         arrays.drag_force.empty())
       return {felt_fraction, dealii::Tensor<1, dim>()};
-    const double h = std::pow(cell->measure(), 1.0 / dim);
+    if (cell->active_cell_index() != sized_cell)
+    {
+      sized_cell   = cell->active_cell_index();
+      sized_cell_h = std::pow(cell->measure(), 1.0 / dim);
+    }
+    const double h = sized_cell_h;
     // What the grain puts into the fields it reads, less what the hole
     // around it in its neighbours' packing takes out: among neighbours at
     // solid fraction s only S(s) of its own share stays (doc/theory.md).

@@ -90,9 +90,12 @@ namespace ImmersedGrains
         for (auto &m : cell_momentum)
           m = 0;
         for (const auto &drag : cell_drags)
+        {
+          const auto shape =
+            HelmholtzFilter<dim>::shape_values(drag.reference_location);
           for (unsigned int j = 0; j < n; ++j)
           {
-            const double N = fe.shape_value(j, drag.reference_location);
+            const double N = shape[j];
             cell_beta(j) += drag.beta * N;
             if (drag.against_last_velocity)
               cell_beta_last(j) += drag.beta * N;
@@ -103,6 +106,7 @@ namespace ImmersedGrains
             for (unsigned int d = 0; d < dim; ++d)
               cell_momentum[d](j) += drag.beta * drag.velocity[d] * N;
           }
+        }
         filter.add_cell_contribution(cell, cell_beta, indices, beta_rhs);
         filter.add_cell_contribution(cell,
                                      cell_beta_last,

@@ -398,6 +398,25 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::array<double, dealii::GeometryInfo<dim>::vertices_per_cell>
+  HelmholtzFilter<dim>::shape_values(const dealii::Point<dim> &x)
+  {
+    // FE_Q(1)'s function j is the product over the axes of 1 - x_d (bit d
+    // of j clear) or x_d (set), each Lagrange factor evaluated as deal.II
+    // does, (x_d - 1) (-1) and (x_d - 0) 1, and multiplied in axis order.
+    std::array<double, dealii::GeometryInfo<dim>::vertices_per_cell> values;
+    for (unsigned int j = 0; j < values.size(); ++j)
+    {
+      double value = 1.;
+      for (unsigned int d = 0; d < dim; ++d)
+        value *= ((j >> d) & 1) ? x[d] : -(x[d] - 1.);
+      values[j] = value;
+    }
+    return values;
+  }
+
+
+  template <int dim>
   const dealii::Mapping<dim> &
   HelmholtzFilter<dim>::get_mapping() const
   {

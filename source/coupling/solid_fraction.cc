@@ -140,9 +140,11 @@ namespace ImmersedGrains
           // Only a law that reads the mean diameter pays for its field.
           const double surface =
             parameters.with_mean_diameter ? g.volume / g.diameter : 0.0;
+          const auto shape =
+            HelmholtzFilter<dim>::shape_values(g.reference_location);
           for (unsigned int j = 0; j < n; ++j)
           {
-            const double N = fe.shape_value(j, g.reference_location);
+            const double N = shape[j];
             cell_volume(j) += g.volume * N;
             cell_surface(j) += surface * N;
             for (unsigned int d = 0; d < dim; ++d)
@@ -370,9 +372,10 @@ namespace ImmersedGrains
     std::vector<double> result;
     for (const auto &x : reference_points)
     {
-      double phi_s = 0;
+      const auto shape = HelmholtzFilter<dim>::shape_values(x);
+      double     phi_s = 0;
       for (unsigned int i = 0; i < n; ++i)
-        phi_s += field[indices[i]] * filter.get_fe().shape_value(i, x);
+        phi_s += field[indices[i]] * shape[i];
       result.push_back(
         std::clamp(1 - phi_s, parameters.fluid_fraction_bound(), 1.0));
     }
@@ -400,10 +403,11 @@ namespace ImmersedGrains
     std::vector<double> result;
     for (const auto &x : reference_points)
     {
-      double v = 0, a = 0;
+      const auto shape = HelmholtzFilter<dim>::shape_values(x);
+      double     v = 0, a = 0;
       for (unsigned int i = 0; i < n; ++i)
       {
-        const double N = filter.get_fe().shape_value(i, x);
+        const double N = shape[i];
         v += volume[indices[i]] * N;
         a += area[indices[i]] * N;
       }

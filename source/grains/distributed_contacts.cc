@@ -198,12 +198,16 @@ namespace ImmersedGrains
     const auto in = dealii::Utilities::MPI::some_to_some(comm, out);
 
     // Mass splitting: every copy of a shared grain carries m/k.
+    shared_owned.clear();
+    shared_slot.resize(n_owned);
     for (unsigned int i = 0; i < n_owned; ++i)
       if (multiplicity[i] > 1)
       {
         g.inverse_mass[i] *= multiplicity[i];
         if (friction)
           g.inverse_inertia[i] *= multiplicity[i];
+        shared_slot[i] = shared_owned.size();
+        shared_owned.push_back(i);
       }
 
     ghost_owner.clear();
@@ -349,26 +353,27 @@ namespace ImmersedGrains
     };
 
     // 1. Ghost copies go to their owners, which average all copies.
+    // Over the shared grains only: a buffer over all owned grains, zeroed
+    // at every glue, made the glue cost as much as the sweeps between.
     exchange(recv_lists, send_lists, glue_to_owner_tag, pack);
-    std::vector<double> sum(n_owned * width, 0.);
-    for (unsigned int i = 0; i < n_owned; ++i)
-      if (multiplicity[i] > 1)
-        pack(i, sum.data() + i * width);
+    glue_sum.resize(shared_owned.size() * width);
+    for (unsigned int s = 0; s < shared_owned.size(); ++s)
+      pack(shared_owned[s], glue_sum.data() + s * width);
     std::size_t offset = 0;
     for (const auto &[q, list] : send_lists)
       for (const unsigned int i : list)
       {
         for (unsigned int c = 0; c < width; ++c)
-          sum[i * width + c] += recv_buffer[offset + c];
+          glue_sum[shared_slot[i] * width + c] += recv_buffer[offset + c];
         offset += width;
       }
-    for (unsigned int i = 0; i < n_owned; ++i)
-      if (multiplicity[i] > 1)
-      {
-        for (unsigned int c = 0; c < width; ++c)
-          sum[i * width + c] /= multiplicity[i];
-        unpack(i, sum.data() + i * width);
-      }
+    for (unsigned int s = 0; s < shared_owned.size(); ++s)
+    {
+      const unsigned int i = shared_owned[s];
+      for (unsigned int c = 0; c < width; ++c)
+        glue_sum[s * width + c] /= multiplicity[i];
+      unpack(i, glue_sum.data() + s * width);
+    }
 
     // 2. The glued velocities go back to every copy.
     exchange(send_lists,

@@ -314,6 +314,11 @@ namespace ImmersedGrains
     std::vector<double>                 gamma;
     // The grain's own disturbance of the velocity it feels (undisturbed()).
     std::vector<dealii::Tensor<1, dim>> self_velocity;
+    // The size of the last cell undisturbed() measured: grains come cell by
+    // cell, and measuring a cell per grain was a tenth of the grains' drag
+    // (reset by setup() when the mesh changes).
+    mutable unsigned int sized_cell   = dealii::numbers::invalid_unsigned_int;
+    mutable double       sized_cell_h = 0;
     // The contact impulse the fluid is told each grain will receive
     // (prepare_fluid_drag()).
     std::vector<dealii::Tensor<1, dim>> predicted_impulse;

@@ -151,10 +151,14 @@ namespace ImmersedGrains
     std::map<unsigned int, std::vector<unsigned int>> send_lists;   // owned
     std::map<unsigned int, std::vector<unsigned int>> recv_lists;   // ghosts
     std::vector<unsigned int>                         multiplicity; // owned
-    std::vector<Contact::GrainPair<dim>>              pairs;
-    std::vector<Contact::WallContact<dim>>            wall_contacts;
-    std::vector<std::uint64_t>                        ids;
-    std::vector<double>                               send_buffer, recv_buffer;
+    // The owned grains with copies elsewhere, ascending, and each one's
+    // place among them (valid for those only): a glue touches these alone.
+    std::vector<unsigned int>              shared_owned, shared_slot;
+    std::vector<double>                    glue_sum;
+    std::vector<Contact::GrainPair<dim>>   pairs;
+    std::vector<Contact::WallContact<dim>> wall_contacts;
+    std::vector<std::uint64_t>             ids;
+    std::vector<double>                    send_buffer, recv_buffer;
 
     double
     distance_to_rank(const dealii::Point<dim> &x, unsigned int rank) const;
