@@ -19,11 +19,16 @@ per N:
 - wall seconds per fluid step, the set-up (placement, first output), peak
   resident memory and the log's estimate.
 
-    benchmarks/suspension/run.py [--ranks R] [N ...]
+    benchmarks/suspension/run.py [--ranks R] [--figure] [N ...]
         (default N = 1000 10000 100000; 1000000 takes about 8.5 minutes and
         3 GB on one core)
 
-Needs build/immersed-grains.
+With --figure, draws doc/figures/suspension_3d_million.png from the last
+state of the largest N's run: the grains in two vertical slabs, through
+the middle of the cube and along a periodic face, coloured by their
+vertical velocity.
+
+Needs build/immersed-grains, python3-numpy and python3-matplotlib.
 """
 import argparse
 import csv
@@ -31,6 +36,7 @@ import math
 import os
 import re
 import subprocess
+import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))))
@@ -113,9 +119,44 @@ def run(n, ranks):
     }
 
 
+def draw(n, ranks):
+    """The two slabs of the figure, from the run of N grains."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    import plot_scene
+    directory = os.path.join(WORK, "n%d_np%d" % (n, ranks))
+    t, x, fields = plot_scene.particle_states(directory, "run.py",
+                                              ["velocity"])[-1]
+    vz = fields["velocity"].reshape(len(x), -1)[:, -1]
+    side = (n * 4 / 3 * math.pi * RADIUS ** 3 / FRACTION) ** (1 / 3)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.6))
+    for ax, (y, name) in zip(axes, [(side / 2, "y = L/2, through the middle"),
+                                    (0.0, "y = 0, a periodic face")]):
+        # Within 50 um of the plane, across the periodic face too.
+        near = np.abs((x[:, 1] - y + side / 2) % side - side / 2) < 5e-5
+        shown = ax.scatter(1e3 * x[near, 0], 1e3 * x[near, 2],
+                           c=1e6 * vz[near], s=0.3, cmap="RdBu_r",
+                           vmin=-60, vmax=60)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("z (mm)")
+        ax.set_title("slab at " + name, fontsize=10)
+    fig.colorbar(shown, ax=axes, label="vertical velocity (um/s)")
+    fig.suptitle("%d beads at solid fraction %.1f, t = %.1f s, mean "
+                 "vertical velocity %.1f um/s" % (n, FRACTION, t,
+                                                  1e6 * vz.mean()))
+    out = os.path.join(ROOT, "doc", "figures", "suspension_3d_million.png")
+    fig.savefig(out, dpi=110)
+    print("wrote " + out)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--ranks", type=int, default=1)
+    parser.add_argument("--figure", action="store_true")
     parser.add_argument("counts", nargs="*", type=int,
                         default=[1000, 10000, 100000])
     args = parser.parse_args()
@@ -131,6 +172,8 @@ def main():
               flush=True)
     print("(%d rank(s); us per grain and sub-step, ms and s per fluid step;"
           " peak: the largest rank's)" % args.ranks)
+    if args.figure:
+        draw(max(args.counts), args.ranks)
 
 
 if __name__ == "__main__":
