@@ -9,7 +9,7 @@ than 20 % (and 2 ms) slower than the figures in FILE (written earlier with
 --save FILE), so that a change that slows a phase shows at once.
 
 Scenes: cloud_2d, cloud_3d (the default), suspension_3d_million (10^6
-grains, about 8.5 minutes and 3 GB; doc/performance.md, "A million
+grains, about 3 minutes and 3 GB; doc/performance.md, "A million
 grains").
 
 Usage (after scripts/setup.sh):

@@ -20,7 +20,7 @@ per N:
   resident memory and the log's estimate.
 
     benchmarks/suspension/run.py [--ranks R] [--figure] [N ...]
-        (default N = 1000 10000 100000; 1000000 takes about 8.5 minutes and
+        (default N = 1000 10000 100000; 1000000 takes about 3 minutes and
         3 GB on one core)
 
 With --figure, draws doc/figures/suspension_3d_million.png from the last

@@ -47,10 +47,10 @@ def solid_fraction(profile):
 def hindered_settling():
     phi = [0.05, 0.10, 0.20, 0.30]
     series = {
-        "3D, l = 8 r, h = 8 r": [1.0038, 1.0086, 1.0195, 1.0431],
-        "3D, l = 16 r, h = 8 r": [0.9999, 1.0002, 1.0009, 1.0033],
-        "2D, l = 8 r, h = 8 r": [1.213, 1.209, 1.463, 1.727],
-        "2D, l = 64 r = L/2, h = 8 r": [0.9971, 1.0005, 1.0033, 1.0045],
+        "3D, l = 8 r, h = 8 r": [0.9999, 0.9997, 0.9980, 0.9973],
+        "3D, l = 16 r, h = 8 r": [0.9995, 0.9993, 0.9990, 0.9991],
+        "2D, l = 8 r, h = 8 r": [1.203, 1.182, 1.282, 1.409],
+        "2D, l = 64 r = L/2, h = 8 r": [0.9963, 0.9997, 1.0008, 0.9929],
     }
     fig, ax = plt.subplots(figsize=(6, 4))
     for name, values in series.items():
@@ -58,7 +58,7 @@ def hindered_settling():
     ax.axhspan(0.97, 1.03, color="0.9", label="±3 %")
     ax.set_xlabel("solid fraction φ_s")
     ax.set_ylabel("v / (ε^4.8 × single-grain velocity)")
-    ax.set_ylim(0.9, 1.8)
+    ax.set_ylim(0.9, 1.5)
     ax.set_title("Hindered settling against the seed's closure", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -101,7 +101,9 @@ namespace ImmersedGrains
                           "list",
                           Selection("ball|box|list|file|lattice"),
                           "ball/box: random non-overlapping fill (random "
-                          "sequential addition); list: Positions; file: "
+                          "sequential addition), across the periodic faces "
+                          "where a box spans a periodic axis of the domain; "
+                          "list: Positions; file: "
                           "File; lattice: square (cubic) lattice of spacing "
                           "2 r_max filling the box Center, Size.");
         prm.declare_entry("Center",
@@ -137,6 +139,17 @@ namespace ImmersedGrains
                           "Initial velocities, same format: one per grain, "
                           "or one for all, or empty (at rest).");
         prm.declare_entry("Random seed", "1", Integer(0), "Seed of the fill.");
+        prm.declare_entry(
+          "Fill across periodic faces",
+          "true",
+          Bool(),
+          "Shape = box spanning a periodic axis of a box domain: true draws "
+          "the centres over the whole period, each grain clear of its "
+          "neighbours' periodic images, so a suspension is homogeneous "
+          "across the periodic faces; false keeps every centre its radius "
+          "inside the box as at a wall, which leaves a layer one radius "
+          "deep empty on each side of the periodic face (in a suspension a "
+          "lighter sheet that drives a box-wide flow; doc/contacts.md).");
         prm.declare_entry("File",
                           "",
                           Anything(),
@@ -570,8 +583,9 @@ namespace ImmersedGrains
         velocities_text = prm.get("Velocities");
         velocities =
           parse_point_list<dim>(velocities_text, place, "Velocities");
-        random_seed    = prm.get_integer("Random seed");
-        placement_file = prm.get("File");
+        random_seed                = prm.get_integer("Random seed");
+        fill_across_periodic_faces = prm.get_bool("Fill across periodic faces");
+        placement_file             = prm.get("File");
         {
           std::filesystem::path path(placement_file);
           if (path.is_relative())

@@ -223,14 +223,24 @@ namespace ImmersedGrains
                     const Point<dim>            &upper,
                     const bool                   ball,
                     const Point<dim>            &center,
-                    const double                 ball_radius)
+                    const double                 ball_radius,
+                    const std::array<bool, dim> &wrap)
     {
       const unsigned int n           = grains.size();
       const auto         keep_inside = [&](GrainSeed<dim> &g)
       {
         for (unsigned int d = 0; d < dim; ++d)
-          g.position[d] =
-            std::clamp(g.position[d], lower[d] + g.radius, upper[d] - g.radius);
+          if (wrap[d])
+          {
+            const double L = upper[d] - lower[d];
+            g.position[d] -= L * std::floor((g.position[d] - lower[d]) / L);
+            if (g.position[d] >= upper[d])
+              g.position[d] = lower[d];
+          }
+          else
+            g.position[d] = std::clamp(g.position[d],
+                                       lower[d] + g.radius,
+                                       upper[d] - g.radius);
         if (ball)
         {
           const Tensor<1, dim> a     = g.position - center;
@@ -242,7 +252,7 @@ namespace ImmersedGrains
       std::vector<Point<dim>>              x(n);
       std::vector<double>                  r(n);
       std::vector<Contact::GrainPair<dim>> pairs;
-      Contact::BucketGrid<dim>             grid(lower, upper);
+      Contact::BucketGrid<dim>             grid(lower, upper, wrap);
       for (unsigned int round = 0; round < 20000; ++round)
       {
         for (unsigned int i = 0; i < n; ++i)
@@ -256,7 +266,7 @@ namespace ImmersedGrains
         {
           auto          &a       = grains[pair.first];
           auto          &b       = grains[pair.second];
-          Tensor<1, dim> ab      = b.position - a.position;
+          Tensor<1, dim> ab      = b.position + pair.shift - a.position;
           double         d       = ab.norm();
           const double   overlap = a.radius + b.radius - d;
           if (overlap <= 0)
@@ -285,9 +295,17 @@ namespace ImmersedGrains
     }
 
     // Random sequential addition into a ball or box, largest grains first.
+    // On the axes where @p wrap is set (a box spanning a periodic axis of
+    // the domain) the centres are drawn over the whole period and grains
+    // meet their neighbours' periodic images: drawn within a radius of the
+    // faces, as on a wall, they left a layer one radius deep on each side
+    // of the periodic face empty, a lighter sheet that drove a box-wide
+    // convection through the suspension.
     template <int dim>
     std::vector<GrainSeed<dim>>
-    random_fill(const GrainParameters<dim> &prm, Random &random)
+    random_fill(const GrainParameters<dim> &prm,
+                Random                     &random,
+                std::array<bool, dim>       wrap)
     {
       const InputLocation where{prm.file, "Grains/Placement"};
       const bool          ball = (prm.shape == PlacementShape::ball);
@@ -306,6 +324,19 @@ namespace ImmersedGrains
       std::vector<double> radii = fill_radii(prm, region_volume, random);
       std::sort(radii.begin(), radii.end(), std::greater<double>());
       const double r_max = radii.empty() ? 0 : radii.front();
+      // A grain then meets at most one image of another (the periodic
+      // overlap check after placement asks the same).
+      for (unsigned int d = 0; d < dim; ++d)
+        wrap[d] = wrap[d] && !ball && upper[d] - lower[d] >= 4 * r_max;
+      // A centre's coordinate on axis d for a grain of radius r: within
+      // the period [lower, upper) where wrapped, clear of the faces else.
+      const auto draw = [&](const unsigned int d, const double r)
+      {
+        if (!wrap[d])
+          return random.uniform(lower[d] + r, upper[d] - r);
+        const double y = random.uniform(lower[d], upper[d]);
+        return y < upper[d] ? y : lower[d];
+      };
       // What the entry that set the number of grains is called.
       const std::string what  = !prm.radii.empty() ? "Radii" :
                                 prm.count > 0      ? "Count" :
@@ -390,7 +421,7 @@ namespace ImmersedGrains
         {
           Point<dim> x;
           for (unsigned int d = 0; d < dim; ++d)
-            x[d] = random.uniform(lower[d] + r, upper[d] - r);
+            x[d] = draw(d, r);
           if (ball && (x - prm.center).norm() > prm.size[0] - r)
             continue;
           std::array<int, dim> c;
@@ -405,16 +436,27 @@ namespace ImmersedGrains
             for (unsigned int d = 0; d < dim; ++d, q /= 3)
             {
               n[d] += int(q % 3) - 1;
+              if (wrap[d])
+                n[d] = (n[d] + int(n_cells[d])) % int(n_cells[d]);
               inside = inside && n[d] >= 0 && n[d] < int(n_cells[d]);
             }
             if (!inside)
               continue;
             for (const unsigned int j : cells[index(n)])
-              if ((grains[j].position - x).norm() < grains[j].radius + r)
+            {
+              Tensor<1, dim> ab = grains[j].position - x;
+              for (unsigned int d = 0; d < dim; ++d)
+                if (wrap[d])
+                {
+                  const double L = upper[d] - lower[d];
+                  ab[d] -= L * std::round(ab[d] / L);
+                }
+              if (ab.norm() < grains[j].radius + r)
               {
                 free = false;
                 break;
               }
+            }
           }
           if (!free)
             continue;
@@ -438,12 +480,12 @@ namespace ImmersedGrains
         Point<dim> x;
         do
           for (unsigned int d = 0; d < dim; ++d)
-            x[d] = random.uniform(lower[d] + r, upper[d] - r);
+            x[d] = draw(d, r);
         while (ball && (x - prm.center).norm() > prm.size[0] - r);
         grains.push_back({x, Tensor<1, dim>(), r});
       }
-      const unsigned int rounds =
-        remove_overlaps(grains, lower, upper, ball, prm.center, prm.size[0]);
+      const unsigned int rounds = remove_overlaps<dim>(
+        grains, lower, upper, ball, prm.center, prm.size[0], wrap);
       if (rounds == dealii::numbers::invalid_unsigned_int)
         where.fail(what,
                    value,
@@ -689,7 +731,32 @@ namespace ImmersedGrains
         {
           GrainParameters<dim> region = prm;
           region.center               = c;
-          for (const auto &g : random_fill(region, random))
+          // A box that spans a periodic axis of a box domain fills it
+          // across the periodic faces. Spanning within 1e-4 of the period
+          // counts (a centre and a size written with six digits differ
+          // from the corners by a few 1e-6 of them), and the period is
+          // then taken from the domain exactly.
+          std::array<bool, dim> wrap;
+          for (unsigned int d = 0; d < dim; ++d)
+          {
+            const double L =
+              geometry.upper_corner[d] - geometry.lower_corner[d];
+            const double tol = 1e-4 * L;
+            wrap[d] =
+              prm.fill_across_periodic_faces && geometry.is_box() &&
+              geometry.is_periodic(d) && prm.shape == PlacementShape::box &&
+              std::abs(c[d] - prm.size[d] / 2 - geometry.lower_corner[d]) <=
+                tol &&
+              std::abs(c[d] + prm.size[d] / 2 - geometry.upper_corner[d]) <=
+                tol;
+            if (wrap[d])
+            {
+              region.center[d] =
+                0.5 * (geometry.lower_corner[d] + geometry.upper_corner[d]);
+              region.size[d] = L;
+            }
+          }
+          for (const auto &g : random_fill<dim>(region, random, wrap))
             grains.push_back(g);
         }
         parameter = prm.centers.size() > 1 ? "Center" : "Size";

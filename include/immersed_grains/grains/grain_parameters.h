@@ -105,7 +105,9 @@ namespace ImmersedGrains
     std::vector<dealii::Point<dim>> positions;
     std::vector<dealii::Point<dim>> velocities; // as points: one per grain
     unsigned int                    random_seed = 1;
-    std::string                     placement_file;
+    // A box spanning a periodic axis is filled across its periodic faces.
+    bool        fill_across_periodic_faces = true;
+    std::string placement_file;
     // placement_file read from the parameter file's folder if relative.
     std::string placement_path;
     // The entry texts, for messages naming them.
