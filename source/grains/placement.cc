@@ -297,10 +297,10 @@ namespace ImmersedGrains
     // Random sequential addition into a ball or box, largest grains first.
     // On the axes where @p wrap is set (a box spanning a periodic axis of
     // the domain) the centres are drawn over the whole period and grains
-    // meet their neighbours' periodic images: drawn within a radius of the
-    // faces, as on a wall, they left a layer one radius deep on each side
-    // of the periodic face empty, a lighter sheet that drove a box-wide
-    // convection through the suspension.
+    // meet their neighbours' periodic images. Drawn a radius clear of the
+    // faces, as at a wall, they would leave a layer one radius deep on each
+    // side of the periodic face empty: a lighter sheet that drives a
+    // box-wide convection through a suspension.
     template <int dim>
     std::vector<GrainSeed<dim>>
     random_fill(const GrainParameters<dim> &prm,
