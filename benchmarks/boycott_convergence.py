@@ -12,9 +12,11 @@ differences.
 
 Usage (after scripts/setup.sh):
     benchmarks/boycott_convergence.py [--cells 4,5,7,10] [--steps 0.005]
-        [--seeds 1] [--ranks N] [--out DIR]
+        [--seeds 1] [--ranks N] [--filter L] [--out DIR]
 --cells lists the subdivisions across (the height gets five times as many);
 the box is 20 grain diameters across, so 5 cells are cells of 4 diameters.
+--filter L runs the drag filtered over L metres (Drag distribution =
+filtered) instead of the scene's cell spread.
 """
 import argparse
 import os
@@ -27,8 +29,11 @@ SCENE = os.path.join(ROOT, "benchmarks", "boycott_small.prm")
 DIAMETERS_ACROSS = 20  # 0.04 m across, grains of 2 mm
 
 
-def scene_text(cells, step, seed):
+def scene_text(cells, step, seed, filter_length=0):
     text = open(SCENE).read()
+    if filter_length > 0:
+        text += ("subsection Coupling\n  set Drag distribution = filtered\n"
+                 "  set Smoothing length = %g\nend\n" % filter_length)
     text = re.sub(r"(?m)^(\s*set Subdivisions\s*=).*$",
                   r"\g<1> %d, %d, %d" % (cells, 5 * cells, cells), text)
     text = re.sub(r"(?m)^(set Time step\s*=).*$", r"\g<1> %g" % step, text)
@@ -46,6 +51,9 @@ def main():
     parser.add_argument("--seeds", default="1",
                         help="placement seeds, comma separated")
     parser.add_argument("--ranks", type=int, default=1)
+    parser.add_argument("--filter", type=float, default=0,
+                        help="the filtered drag over this length [m] "
+                        "instead of the cell spread")
     parser.add_argument("--out", default=os.path.join(
         ROOT, "benchmarks", "results", "boycott_convergence"))
     args = parser.parse_args()
@@ -57,9 +65,12 @@ def main():
         for step in [float(s) for s in args.steps.split(",")]:
             for seed in [int(s) for s in args.seeds.split(",")]:
                 directory = os.path.join(
-                    args.out, "c%d_dt%g_s%d" % (cells, step, seed))
+                    args.out, "c%d_dt%g_s%d%s" % (
+                        cells, step, seed,
+                        "_l%g" % args.filter if args.filter else ""))
                 rows = scene_runner.run_scene(
-                    scene_text(cells, step, seed), directory, args.ranks)
+                    scene_text(cells, step, seed, args.filter), directory,
+                    args.ranks)
                 last = rows[-1]
                 steps = len(rows) - 1
                 iterations = sum(float(r["fluid_iterations"])

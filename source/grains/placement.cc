@@ -1,6 +1,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <immersed_grains/contact/bucket_grid.h>
+#include <immersed_grains/grains/periodic_span.h>
 #include <immersed_grains/grains/placement.h>
 
 #include <algorithm>
@@ -732,28 +733,19 @@ namespace ImmersedGrains
           GrainParameters<dim> region = prm;
           region.center               = c;
           // A box that spans a periodic axis of a box domain fills it
-          // across the periodic faces. Spanning within 1e-4 of the period
-          // counts (a centre and a size written with six digits differ
-          // from the corners by a few 1e-6 of them), and the period is
-          // then taken from the domain exactly.
+          // across the periodic faces, over the domain's period exactly.
           std::array<bool, dim> wrap;
           for (unsigned int d = 0; d < dim; ++d)
           {
-            const double L =
-              geometry.upper_corner[d] - geometry.lower_corner[d];
-            const double tol = 1e-4 * L;
-            wrap[d] =
-              prm.fill_across_periodic_faces && geometry.is_box() &&
-              geometry.is_periodic(d) && prm.shape == PlacementShape::box &&
-              std::abs(c[d] - prm.size[d] / 2 - geometry.lower_corner[d]) <=
-                tol &&
-              std::abs(c[d] + prm.size[d] / 2 - geometry.upper_corner[d]) <=
-                tol;
+            wrap[d] = prm.fill_across_periodic_faces &&
+                      prm.shape == PlacementShape::box &&
+                      spans_periodic_axis(geometry, c, prm.size, d);
             if (wrap[d])
             {
               region.center[d] =
                 0.5 * (geometry.lower_corner[d] + geometry.upper_corner[d]);
-              region.size[d] = L;
+              region.size[d] =
+                geometry.upper_corner[d] - geometry.lower_corner[d];
             }
           }
           for (const auto &g : random_fill<dim>(region, random, wrap))

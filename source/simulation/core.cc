@@ -363,6 +363,12 @@ namespace ImmersedGrains
     }
     placed_grains = grain_seeds.size();
     choose_drag_distribution(file);
+    // 'auto' correction: on in 3D with the cell spread, given or chosen.
+    prm.enter_subsection("Coupling");
+    if (prm.get("Self-disturbance correction") == "auto")
+      coupling_parameters.self_correction =
+        dim == 3 && coupling_parameters.drag_distribution == "cell";
+    prm.leave_subsection();
 
     // Stop here, before anything large is allocated or written, if the
     // scene cannot fit: the kernel would kill it half-way instead.
