@@ -40,9 +40,11 @@ namespace ImmersedGrains
     {
       if (grains.shape != PlacementShape::box)
         return false;
-      for (unsigned int d = 0; d < dim; ++d)
-        if (spans_periodic_axis(geometry, grains.center, grains.size, d))
-          return true;
+      // Each centre is filled as its own box, as placement.cc does.
+      for (const auto &center : grains.centers)
+        for (unsigned int d = 0; d < dim; ++d)
+          if (spans_periodic_axis(geometry, center, grains.size, d))
+            return true;
       return false;
     }
 

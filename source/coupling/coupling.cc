@@ -187,7 +187,9 @@ namespace ImmersedGrains
         "for ever");
 
       const std::string correction = prm.get("Self-disturbance correction");
-      // 'auto' distributions are 'cell' in 3D (Simulation chooses).
+      // An 'auto' distribution counts as the cell spread until Simulation
+      // chooses one (choose_drag_distribution), after which the same rule is
+      // applied to the choice.
       self_correction = correction == "auto" ?
                           dim == 3 && (drag_distribution == "cell" ||
                                        drag_distribution == "auto") :

@@ -363,7 +363,8 @@ namespace ImmersedGrains
     }
     placed_grains = grain_seeds.size();
     choose_drag_distribution(file);
-    // 'auto' correction: on in 3D with the cell spread, given or chosen.
+    // An 'auto' correction: the rule of Coupling::Parameters, on in 3D with
+    // the cell spread, applied again now that 'auto' has become a choice.
     prm.enter_subsection("Coupling");
     if (prm.get("Self-disturbance correction") == "auto")
       coupling_parameters.self_correction =
