@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The 3000-disc frictionless pile of tests/grains_pile_at_rest.prm, run to
+"""The 3000-disc frictionless pile of pile_2d_3000.prm beside this script, run to
 t = 4 s with the default contact solver (Gauss-Seidel with its subspace
 correction), with plain Gauss-Seidel (Subspace correction every = 0) and
 with apgd,
@@ -50,7 +50,8 @@ SOLVERS = {
 
 def scene(label, end_time):
     solver, extra = SOLVERS[label]
-    text = open(os.path.join(ROOT, "tests", "grains_pile_at_rest.prm")).read()
+    text = open(os.path.join(ROOT, "benchmarks", "pile_at_rest",
+                             "pile_2d_3000.prm")).read()
     out = os.path.join(WORK, label)
     lines = []
     for line in text.splitlines():

@@ -482,8 +482,8 @@ namespace ImmersedGrains
       // the key of their midpoint, so that a backward sweep carries the
       // weight from the top of a pile down to its floor in one pass, and a
       // forward sweep the reaction back up, instead of one layer per sweep.
-      // On the 5000-disc pile (tests/grains_pile.prm) this takes 27 % fewer
-      // sweeps than the rounds above and 38 % less time. Ties
+      // On the 5000-disc pile (benchmarks/pile_at_rest/pile_2d_5000.prm) this
+      // takes 27 % fewer sweeps than the rounds above and 38 % less time. Ties
       // keep the input order, so the order is deterministic.
       AssertThrow(sweep_key.size() == n_grains,
                   dealii::ExcMessage("ContactSolver: sweep_key must be "
