@@ -3,10 +3,6 @@
 export OMPI_ALLOW_RUN_AS_ROOT=1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_rmaps_base_oversubscribe=1
-# A run started without mpirun is an MPI singleton: Open MPI would start a
-# helper daemon for it (0.2 s of each of the suite's few hundred runs) that
-# only a program spawning further processes needs.
-export OMPI_MCA_ess_singleton_isolated=1
 # The machine's cores, for make and ctest: counted before OMP_NUM_THREADS is
 # set below, which GNU nproc would otherwise report.
 export IMMERSED_GRAINS_JOBS=${IMMERSED_GRAINS_JOBS:-$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)}

@@ -40,8 +40,7 @@ using namespace dealii;
 namespace
 {
   const std::string packings =
-    std::string(__FILE__).substr(0, std::string(__FILE__).rfind('/')) +
-    "/../prm/packings/";
+    std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/../prm/packings/";
 
   void
   avalanche(const std::string &name)

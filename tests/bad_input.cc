@@ -386,6 +386,15 @@ end
        dry_grain,
      "Boundary conditions",
      "periodic"},
+    {"gmsh_periodic_without_partner",
+     "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File "
+     "= " +
+       meshes +
+       "periodic_square_2d.msh\n set Boundary conditions = 1: wall, 2: "
+       "wall, 3: wall, 4: periodic\nend\n" +
+       dry_grain,
+     "Boundary conditions",
+     "periodic boundary id 4"},
     {"gmsh_manifold_off_its_curve",
      "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File = " +
        meshes +

@@ -56,8 +56,7 @@ using namespace dealii;
 namespace
 {
   const std::string packings =
-    std::string(__FILE__).substr(0, std::string(__FILE__).rfind('/')) +
-    "/packings/";
+    std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/packings/";
 
   void
   collapse(const std::string &name)

@@ -70,7 +70,11 @@ namespace ImmersedGrains
     for (unsigned int d = 0; d < dim; ++d)
       if (geometry.is_periodic(d))
         dealii::DoFTools::make_periodicity_constraints(
-          dof_handler, 2 * d, 2 * d + 1, d, constraints);
+          dof_handler,
+          geometry.periodic_boundary_ids(d).first,
+          geometry.periodic_boundary_ids(d).second,
+          d,
+          constraints);
     constraints.close();
 
     dealii::DynamicSparsityPattern dsp(relevant);

@@ -626,7 +626,11 @@ namespace ImmersedGrains
       for (unsigned int d = 0; d < dim; ++d)
         if (geometry.is_periodic(d))
           dealii::DoFTools::make_periodicity_constraints(
-            dof_handler, 2 * d, 2 * d + 1, d, c);
+            dof_handler,
+            geometry.periodic_boundary_ids(d).first,
+            geometry.periodic_boundary_ids(d).second,
+            d,
+            c);
       for (const auto &[f, type] : geometry.boundary_types)
       {
         if (type == BoundaryType::wall)
@@ -663,7 +667,11 @@ namespace ImmersedGrains
     for (unsigned int d = 0; d < dim; ++d)
       if (geometry.is_periodic(d))
         dealii::DoFTools::make_periodicity_constraints(
-          dof_handler, 2 * d, 2 * d + 1, d, pressure_mass_constraints);
+          dof_handler,
+          geometry.periodic_boundary_ids(d).first,
+          geometry.periodic_boundary_ids(d).second,
+          d,
+          pressure_mass_constraints);
     pressure_mass_constraints.close();
   }
 

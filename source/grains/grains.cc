@@ -875,7 +875,7 @@ namespace ImmersedGrains
         largest[1] = std::max(largest[1], (c.velocity[i] - v0).norm());
       }
       bool left = false;
-      for (unsigned int d = 0; d < dim && !fixed && geometry.is_box(); ++d)
+      for (unsigned int d = 0; d < dim && !fixed; ++d)
       {
         const double L = hi[d] - lo[d];
         if (geometry.is_periodic(d))
@@ -883,6 +883,9 @@ namespace ImmersedGrains
           x[d] = geometry.wrap(d, x[d]);
           continue;
         }
+        // A mesh's walls and open boundaries: below.
+        if (!geometry.is_box())
+          continue;
         for (unsigned int side = 0; side < 2; ++side)
         {
           const bool beyond = side == 0 ? x[d] < lo[d] : x[d] > hi[d];

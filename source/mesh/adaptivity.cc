@@ -24,40 +24,44 @@ namespace ImmersedGrains
 {
   namespace
   {
-    // For each vertex on a periodic face of the box, the vertices that
-    // periodicity identifies with it: its image across that face and, where
-    // periodic faces meet, across their edges and corners. Cells around
-    // either touch through the periodic boundary. Empty without
-    // periodicity. The coordinates compare exactly: a box mesh's vertices
-    // on one face share the coordinate normal to it, and those along it are
-    // computed the same way on the opposite face.
+    // For each vertex on a periodic face of the domain (a face of its
+    // bounding box), the vertices that periodicity identifies with it: its
+    // image across that face and, where periodic faces meet, across their
+    // edges and corners. Cells around either touch through the periodic
+    // boundary. Empty without periodicity. A vertex within 1e-10 of the
+    // extent of a face is on it and is taken to lie there exactly; the
+    // coordinates along the face compare exactly (a box mesh computes them
+    // the same way on both faces, a Gmsh mesh's periodic nodes are copies
+    // shifted along the axis, and refinement keeps both so).
     template <int dim>
     std::vector<std::vector<unsigned int>>
-    periodic_vertex_images(const dealii::Triangulation<dim> &triangulation)
+    periodic_vertex_images(const dealii::Triangulation<dim> &triangulation,
+                           const Geometry<dim>              &geometry)
     {
       std::vector<std::vector<unsigned int>> images;
       std::array<bool, dim>                  periodic{};
       bool                                   any = false;
-      for (const auto &entry : triangulation.get_periodic_face_map())
+      for (unsigned int d = 0; d < dim; ++d)
       {
-        periodic[entry.first.second / 2] = true;
-        any                              = true;
+        periodic[d] = geometry.is_periodic(d);
+        any |= periodic[d];
       }
       if (!any)
         return images;
 
       const auto              &vertices = triangulation.get_vertices();
       const std::vector<bool> &used     = triangulation.get_used_vertices();
-      std::array<double, dim>  low, high;
-      low.fill(std::numeric_limits<double>::max());
-      high.fill(std::numeric_limits<double>::lowest());
-      for (unsigned int v = 0; v < vertices.size(); ++v)
-        if (used[v])
-          for (unsigned int d = 0; d < dim; ++d)
-          {
-            low[d]  = std::min(low[d], vertices[v][d]);
-            high[d] = std::max(high[d], vertices[v][d]);
-          }
+      const auto              &low      = geometry.lower_corner;
+      const auto              &high     = geometry.upper_corner;
+      // -1 below, +1 on the upper face, 0 off the faces of axis d.
+      const auto side = [&](const double x, const unsigned int d)
+      {
+        const double tol = 1e-10 * (high[d] - low[d]);
+        return !periodic[d]                 ? 0 :
+               std::abs(x - low[d]) <= tol  ? -1 :
+               std::abs(x - high[d]) <= tol ? 1 :
+                                              0;
+      };
 
       std::map<std::array<double, dim>, unsigned int> on_faces;
       for (unsigned int v = 0; v < vertices.size(); ++v)
@@ -67,8 +71,9 @@ namespace ImmersedGrains
           bool                    on_face = false;
           for (unsigned int d = 0; d < dim; ++d)
           {
-            x[d] = vertices[v][d];
-            on_face |= periodic[d] && (x[d] == low[d] || x[d] == high[d]);
+            const int s = side(vertices[v][d], d);
+            x[d]        = s < 0 ? low[d] : s > 0 ? high[d] : vertices[v][d];
+            on_face |= s != 0;
           }
           if (on_face)
             on_faces.emplace(x, v);
@@ -84,8 +89,9 @@ namespace ImmersedGrains
           for (unsigned int d = 0; d < dim && valid; ++d)
             if (directions & (1u << d))
             {
-              valid    = periodic[d] && (x[d] == low[d] || x[d] == high[d]);
-              image[d] = x[d] == low[d] ? high[d] : low[d];
+              const int s = side(x[d], d);
+              valid       = s != 0;
+              image[d]    = s < 0 ? high[d] : low[d];
             }
           if (!valid)
             continue;
@@ -335,7 +341,12 @@ namespace ImmersedGrains
   Adaptivity<dim>::active_cell_at(dealii::Point<dim> point) const
   {
     if (!geometry.is_box())
+    {
+      for (unsigned int d = 0; d < dim; ++d)
+        if (geometry.is_periodic(d))
+          point[d] = geometry.wrap(d, point[d]);
       return mesh_cell_at(point);
+    }
     const auto  &lo = geometry.lower_corner;
     const auto  &hi = geometry.upper_corner;
     unsigned int k = 0, stride = 1;
@@ -584,7 +595,7 @@ namespace ImmersedGrains
     const auto vertex_cells = dealii::GridTools::vertex_to_cell_map(
       static_cast<const dealii::Triangulation<dim> &>(triangulation));
     const auto periodic_images = periodic_vertex_images(
-      static_cast<const dealii::Triangulation<dim> &>(triangulation));
+      static_cast<const dealii::Triangulation<dim> &>(triangulation), geometry);
     // One layer beyond the band: cells there are kept, not coarsened, or
     // a parent coarsened next to the band would reach into it and be
     // refined again at the next adaptation, and so on.

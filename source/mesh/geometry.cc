@@ -98,7 +98,9 @@ namespace ImmersedGrains
         "(no-slip), slip (no normal flow), open (traction-free, "
         "Fluid/Open boundary pressure; grains leave), inflow or velocity "
         "(Fluid/Inflow velocity; grains meet it as a wall) or periodic "
-        "(both faces of a box's direction).");
+        "(both faces of a box's direction; on a Gmsh mesh two ids on the "
+        "two faces of its bounding box normal to an axis, their nodes "
+        "matching by a shift along it).");
     }
     prm.leave_subsection();
   }
@@ -254,12 +256,16 @@ namespace ImmersedGrains
                   "a box's boundary ids are " + id_list(faces) +
                     ", one per face");
     for (unsigned int d = 0; d < dim; ++d)
+    {
       where.require((boundary_types[2 * d] == BoundaryType::periodic) ==
                       (boundary_types[2 * d + 1] == BoundaryType::periodic),
                     "Boundary conditions",
                     bc_text,
                     "periodic faces come in pairs (both faces of a "
                     "direction)");
+      periodic[d]     = boundary_types[2 * d] == BoundaryType::periodic;
+      periodic_ids[d] = {2 * d, 2 * d + 1};
+    }
   }
 
 
@@ -329,10 +335,109 @@ namespace ImmersedGrains
                     "boundary id " + std::to_string(id) + " is not on " +
                       mesh_file + "'s boundary (its ids: " + id_list(on_mesh) +
                       ")");
-      where.require(type != BoundaryType::periodic,
+    }
+    pair_periodic_ids(where, bc_text);
+  }
+
+
+  template <int dim>
+  void
+  Geometry<dim>::pair_periodic_ids(const InputLocation &where,
+                                   const std::string   &bc_text)
+  {
+    // Each periodic id must lie on one face of the bounding box, and the
+    // two faces normal to an axis pair up: the grains, the neighbour
+    // search and the adaptive mesh wrap positions by the box's extent.
+    periodic.fill(false);
+    std::array<std::array<int, 2>, dim> on_side;
+    for (auto &sides : on_side)
+      sides = {{-1, -1}};
+    const char *const axis_names = "xyz";
+    for (const auto &[id, type] : boundary_types)
+    {
+      if (type != BoundaryType::periodic)
+        continue;
+      // Per axis and side, whether every vertex of the id's faces lies on
+      // that face of the bounding box.
+      std::array<std::array<bool, 2>, dim> flat;
+      for (auto &sides : flat)
+        sides = {{true, true}};
+      for (const auto &cell : coarse_mesh->active_cell_iterators())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f) && cell->face(f)->boundary_id() == id)
+            for (const unsigned int v : cell->face(f)->vertex_indices())
+              for (unsigned int d = 0; d < dim; ++d)
+              {
+                const double x   = cell->face(f)->vertex(v)[d];
+                const double tol = 1e-10 * (upper_corner[d] - lower_corner[d]);
+                flat[d][0] = flat[d][0] && std::abs(x - lower_corner[d]) <= tol;
+                flat[d][1] = flat[d][1] && std::abs(x - upper_corner[d]) <= tol;
+              }
+      bool placed = false;
+      for (unsigned int d = 0; d < dim && !placed; ++d)
+        for (unsigned int side = 0; side < 2 && !placed; ++side)
+          if (flat[d][side])
+          {
+            where.require(on_side[d][side] < 0,
+                          "Boundary conditions",
+                          bc_text,
+                          "periodic boundary ids " +
+                            std::to_string(on_side[d][side]) + " and " +
+                            std::to_string(id) + " lie on the same face " +
+                            axis_names[d] + " = " +
+                            std::to_string(side == 0 ? lower_corner[d] :
+                                                       upper_corner[d]) +
+                            " of " + mesh_file + "; one id per face");
+            on_side[d][side] = id;
+            placed           = true;
+          }
+      where.require(placed,
                     "Boundary conditions",
                     bc_text,
-                    "periodic boundaries need Geometry = box");
+                    "periodic boundary id " + std::to_string(id) + " of " +
+                      mesh_file +
+                      " does not lie on a face of the mesh's bounding box "
+                      "(periodic pairs are the two faces normal to an axis)");
+    }
+    for (unsigned int d = 0; d < dim; ++d)
+    {
+      if (on_side[d][0] < 0 && on_side[d][1] < 0)
+        continue;
+      const int lone = on_side[d][0] < 0 ? on_side[d][1] : on_side[d][0];
+      where.require(on_side[d][0] >= 0 && on_side[d][1] >= 0,
+                    "Boundary conditions",
+                    bc_text,
+                    "periodic boundary id " + std::to_string(lone) + " of " +
+                      mesh_file + " has no periodic partner on the opposite " +
+                      axis_names[d] + " face");
+      periodic[d]     = true;
+      periodic_ids[d] = {static_cast<dealii::types::boundary_id>(on_side[d][0]),
+                         static_cast<dealii::types::boundary_id>(
+                           on_side[d][1])};
+      std::vector<dealii::GridTools::PeriodicFacePair<
+        typename dealii::Triangulation<dim>::cell_iterator>>
+           pairs;
+      bool matched = true;
+      try
+      {
+        dealii::GridTools::collect_periodic_faces(*coarse_mesh,
+                                                  periodic_ids[d].first,
+                                                  periodic_ids[d].second,
+                                                  d,
+                                                  pairs);
+      }
+      catch (...)
+      {
+        matched = false;
+      }
+      where.require(matched,
+                    "Boundary conditions",
+                    bc_text,
+                    "the faces of periodic boundary ids " +
+                      std::to_string(on_side[d][0]) + " and " +
+                      std::to_string(on_side[d][1]) + " of " + mesh_file +
+                      " do not match by a shift along " + axis_names[d] +
+                      " (Gmsh: Periodic Curve or Periodic Surface)");
     }
   }
 
@@ -602,7 +707,16 @@ namespace ImmersedGrains
   bool
   Geometry<dim>::is_periodic(const unsigned int direction) const
   {
-    return box && boundary_types.at(2 * direction) == BoundaryType::periodic;
+    return periodic[direction];
+  }
+
+
+  template <int dim>
+  std::pair<dealii::types::boundary_id, dealii::types::boundary_id>
+  Geometry<dim>::periodic_boundary_ids(const unsigned int direction) const
+  {
+    Assert(periodic[direction], dealii::ExcInternalError());
+    return periodic_ids[direction];
   }
 
 
@@ -946,10 +1060,10 @@ namespace ImmersedGrains
         dealii::GridTools::get_coarse_mesh_description(*coarse_mesh);
       tria.create_triangulation(vertices, cells, faces);
       attach_manifolds(tria);
-      return;
     }
-    dealii::GridGenerator::subdivided_hyper_rectangle(
-      tria, subdivisions, lower_corner, upper_corner, /*colorize=*/true);
+    else
+      dealii::GridGenerator::subdivided_hyper_rectangle(
+        tria, subdivisions, lower_corner, upper_corner, /*colorize=*/true);
 
     std::vector<dealii::GridTools::PeriodicFacePair<
       typename dealii::parallel::distributed::Triangulation<
@@ -957,8 +1071,11 @@ namespace ImmersedGrains
       periodic_faces;
     for (unsigned int d = 0; d < dim; ++d)
       if (is_periodic(d))
-        dealii::GridTools::collect_periodic_faces(
-          tria, 2 * d, 2 * d + 1, d, periodic_faces);
+        dealii::GridTools::collect_periodic_faces(tria,
+                                                  periodic_ids[d].first,
+                                                  periodic_ids[d].second,
+                                                  d,
+                                                  periodic_faces);
     if (!periodic_faces.empty())
       tria.add_periodicity(periodic_faces);
   }

@@ -9,9 +9,11 @@
 #include <immersed_grains/contact/walls.h>
 #include <immersed_grains/parameters.h>
 
+#include <array>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dealii
@@ -77,8 +79,16 @@ namespace ImmersedGrains
     bool
     is_cartesian() const;
 
+    /** Whether @p direction is periodic: on a box both its faces are
+     *  `periodic`, on a Gmsh mesh two `periodic` boundary ids lie on the
+     *  two faces of the mesh's bounding box normal to it. */
     bool
     is_periodic(unsigned int direction) const;
+
+    /** The boundary ids on the lower and the upper side of the periodic
+     *  @p direction. */
+    std::pair<dealii::types::boundary_id, dealii::types::boundary_id>
+    periodic_boundary_ids(unsigned int direction) const;
 
     /** @p x moved by whole periods into [lower, upper) along the
      *  periodic @p direction. */
@@ -193,6 +203,9 @@ namespace ImmersedGrains
                           const std::string   &bc_text);
 
     void
+    pair_periodic_ids(const InputLocation &where, const std::string &bc_text);
+
+    void
     read_mesh(const InputLocation &where, const std::string &text);
 
     void
@@ -202,6 +215,11 @@ namespace ImmersedGrains
     void
     attach_manifolds(dealii::Triangulation<dim> &tria) const;
 
+    std::array<bool, dim> periodic{};
+    std::array<
+      std::pair<dealii::types::boundary_id, dealii::types::boundary_id>,
+      dim>
+                                                periodic_ids;
     bool                                        box           = true;
     bool                                        cartesian     = true;
     double                                      domain_volume = 0;
