@@ -37,117 +37,28 @@
 // of the exchange 0.621, one-way coupling 0.0075.
 #include <deal.II/base/mpi.h>
 
-#include "checkpoint_test_support.h"
+#include "coupled_shear_wave.h"
 
-#include <cmath>
 #include <iostream>
-#include <sstream>
 #include <string>
 
 using namespace dealii;
-using namespace ImmersedGrains;
 
 namespace
 {
-  constexpr double L = 3.2e-3, radius = 5e-5, grain_density = 2500,
-                   density = 50, viscosity = 1e-4, length = 4e-4, B0 = 1e-3,
-                   end_time      = 0.08;
-  constexpr unsigned int lattice = 8;
-
-  // B(t) of the exact solution, from A(0) = 0, B(0) = B0.
-  double
-  exact_amplitude(const double t)
-  {
-    const double k    = 2 * M_PI / L;
-    const double N    = lattice * lattice;
-    const double m    = grain_density * M_PI * radius * radius;
-    const double gam  = 12 * viscosity;
-    const double phi  = 1 - N * M_PI * radius * radius / (L * L);
-    const double D    = N / (L * L) * gam / (phi * density);
-    const double G    = gam / m;
-    const double a    = 1 / (1 + k * k * length * length);
-    const double m11  = -viscosity / density * k * k - D * a * a;
-    const double m22  = -G;
-    const double tr   = m11 + m22;
-    const double det  = m11 * m22 - (D * a) * (G * a);
-    const double root = std::sqrt(tr * tr - 4 * det);
-    const double l1 = (tr + root) / 2, l2 = (tr - root) / 2;
-    return B0 *
-           ((m22 - l2) * std::exp(l1 * t) + (l1 - m22) * std::exp(l2 * t)) /
-           (l1 - l2);
-  }
-
-  // Runs the wave on cells of L / @p cells with step @p dt into
-  // @p directory; returns the largest |B / B_exact - 1| over its steps.
   double
   largest_error(const std::string &directory,
                 const unsigned int cells,
                 const double       dt)
   {
-    const double       s = L / lattice, k = 2 * M_PI / L;
-    std::ostringstream positions, velocities;
-    positions.precision(17);
-    velocities.precision(17);
-    for (unsigned int j = 0; j < lattice; ++j)
-      for (unsigned int i = 0; i < lattice; ++i)
-      {
-        const char *separator = i + j == 0 ? "" : "; ";
-        positions << separator << (i + 0.5) * s << ", " << (j + 0.5) * s;
-        velocities << separator << B0 * std::sin(k * (j + 0.5) * s) << ", 0";
-      }
-    std::ostringstream text;
-    text << "set Dimension = 2\nset Output directory = " << directory
-         << "\nset End time = " << end_time << "\nset Time step = " << dt
-         << "\nsubsection Mesh\n  set Lower corner = 0, 0\n"
-         << "  set Upper corner = " << L << ", " << L
-         << "\n  set Subdivisions = " << cells << ", " << cells << R"(
-  set Initial refinement = 0
-  set Boundary conditions = periodic, periodic, periodic, periodic
-end
-subsection Fluid
-  set Density   = 50
-  set Viscosity = 1e-4
-  set Advection = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 5e-5
-  set Density = 2500
-  subsection Placement
-    set Shape = list
-)"
-         << "    set Positions = " << positions.str()
-         << "\n    set Velocities = " << velocities.str() << R"(
-  end
-end
-subsection Coupling
-  set Drag law          = Stokes
-  set Drag distribution = filtered
-  set Smoothing length  = 4e-4
-end
-subsection Gravity
-  set Vector = 0, 0
-end
-subsection Output
-  set Terminal output = quiet
-end
-)";
-    run_scene<2>(directory + ".prm", text.str());
-
-    const auto         rows   = read_csv_rows(directory + "/statistics.csv");
-    const unsigned int time   = column_index(rows, "time"),
-                       energy = column_index(rows, "kinetic_energy");
-    const double m            = grain_density * M_PI * radius * radius;
-    double       largest      = 0;
-    for (unsigned int r = 1; r < rows.size(); ++r)
-    {
-      const double B =
-        std::sqrt(4 * std::stod(rows[r][energy]) / (m * lattice * lattice));
-      largest =
-        std::max(largest,
-                 std::abs(B / exact_amplitude(std::stod(rows[r][time])) - 1));
-    }
-    return largest;
+    std::ostringstream mesh;
+    mesh << "subsection Mesh\n  set Lower corner = 0, 0\n  set Upper corner = "
+         << shear_wave::L << ", " << shear_wave::L
+         << "\n  set Subdivisions = " << cells << ", " << cells
+         << "\n  set Initial refinement = 0\n  set Boundary conditions = "
+            "periodic, periodic, periodic, periodic\nend";
+    return shear_wave::largest_error(
+      shear_wave::run(directory, mesh.str(), dt));
   }
 } // namespace
 
@@ -160,6 +71,8 @@ main(int argc, char **argv)
   const double                     fine   = largest_error("fine", 32, 1.25e-4);
   if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) != 0)
     return 0;
+  using shear_wave::B0;
+  using shear_wave::exact_amplitude;
   std::cout.precision(4);
   std::cout << "exact B/B0 at 0.02, 0.05, 0.08 s: "
             << exact_amplitude(0.02) / B0 << ", " << exact_amplitude(0.05) / B0

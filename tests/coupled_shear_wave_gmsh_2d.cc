@@ -29,134 +29,49 @@
 // drop B by an eighth, and the count is printed.
 #include <deal.II/base/mpi.h>
 
-#include "checkpoint_test_support.h"
+#include "coupled_shear_wave.h"
 
-#include <cmath>
 #include <iostream>
-#include <sstream>
 #include <string>
 
 using namespace dealii;
-using namespace ImmersedGrains;
 
 namespace
 {
-  constexpr double L = 3.2e-3, radius = 5e-5, grain_density = 2500,
-                   density = 50, viscosity = 1e-4, length = 4e-4, B0 = 1e-3,
-                   end_time      = 0.08;
-  constexpr unsigned int lattice = 8;
-
-  // B(t) of the exact solution, from A(0) = 0, B(0) = B0
-  // (coupled_shear_wave_2d.cc).
-  double
-  exact_amplitude(const double t)
+  struct Run
   {
-    const double k    = 2 * M_PI / L;
-    const double N    = lattice * lattice;
-    const double m    = grain_density * M_PI * radius * radius;
-    const double gam  = 12 * viscosity;
-    const double phi  = 1 - N * M_PI * radius * radius / (L * L);
-    const double D    = N / (L * L) * gam / (phi * density);
-    const double G    = gam / m;
-    const double a    = 1 / (1 + k * k * length * length);
-    const double m11  = -viscosity / density * k * k - D * a * a;
-    const double m22  = -G;
-    const double tr   = m11 + m22;
-    const double det  = m11 * m22 - (D * a) * (G * a);
-    const double root = std::sqrt(tr * tr - 4 * det);
-    const double l1 = (tr + root) / 2, l2 = (tr - root) / 2;
-    return B0 *
-           ((m22 - l2) * std::exp(l1 * t) + (l1 - m22) * std::exp(l2 * t)) /
-           (l1 - l2);
+    double       largest_error;
+    unsigned int grains, crossed;
+  };
+
+
+  Run
+  run_wave(const std::string &directory,
+           const unsigned int refinement,
+           const double       dt)
+  {
+    using namespace shear_wave;
+    std::ostringstream mesh;
+    mesh << "subsection Mesh\n  set Geometry = gmsh\n  set File = "
+         << IMMERSED_GRAINS_TEST_MESHES
+         << "/periodic_square_2d.msh\n  set Initial refinement = " << refinement
+         << "\n  set Boundary conditions = 1: periodic, 2: periodic, 3: "
+            "periodic, 4: periodic\nend";
+    // The last column starts 10 um inside the right side.
+    const auto rows =
+      shear_wave::run(directory, mesh.str(), dt, L / lattice / 2 - 1e-5);
+    const unsigned int particles = column_index(rows, "particles"),
+                       centroid  = column_index(rows, "centroid_x");
+    // The rows move as much in -x as in +x: the centroid moves only by the
+    // grains carried from x = L to x = 0, L / 64 each.
+    return {largest_error(rows),
+            static_cast<unsigned int>(std::stoi(rows.back()[particles])),
+            static_cast<unsigned int>(
+              std::lround((std::stod(rows[1][centroid]) -
+                           std::stod(rows.back()[centroid])) /
+                          (L / (lattice * lattice))))};
   }
 } // namespace
-
-
-struct Run
-{
-  double       largest_error;
-  unsigned int grains, crossed;
-};
-
-
-Run
-run_wave(const std::string &directory,
-         const unsigned int refinement,
-         const double       dt)
-{
-  const double       s = L / lattice, k = 2 * M_PI / L, shift = s / 2 - 1e-5;
-  std::ostringstream positions, velocities;
-  positions.precision(17);
-  velocities.precision(17);
-  for (unsigned int j = 0; j < lattice; ++j)
-    for (unsigned int i = 0; i < lattice; ++i)
-    {
-      const char *separator = i + j == 0 ? "" : "; ";
-      positions << separator << (i + 0.5) * s + shift << ", " << (j + 0.5) * s;
-      velocities << separator << B0 * std::sin(k * (j + 0.5) * s) << ", 0";
-    }
-  std::ostringstream text;
-  text << "set Dimension = 2\nset Output directory = " << directory
-       << "\nset End time = " << end_time << "\nset Time step = " << dt
-       << "\nsubsection Mesh\n  set Geometry = gmsh\n  set File = "
-       << IMMERSED_GRAINS_TEST_MESHES
-       << "/periodic_square_2d.msh\n  set Initial refinement = " << refinement
-       << R"(
-  set Boundary conditions = 1: periodic, 2: periodic, 3: periodic, 4: periodic
-end
-subsection Fluid
-  set Density   = 50
-  set Viscosity = 1e-4
-  set Advection = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 5e-5
-  set Density = 2500
-  subsection Placement
-    set Shape = list
-)"
-       << "    set Positions = " << positions.str()
-       << "\n    set Velocities = " << velocities.str() << R"(
-  end
-end
-subsection Coupling
-  set Drag law          = Stokes
-  set Drag distribution = filtered
-  set Smoothing length  = 4e-4
-end
-subsection Gravity
-  set Vector = 0, 0
-end
-subsection Output
-  set Terminal output = quiet
-end
-)";
-  run_scene<2>(directory + ".prm", text.str());
-
-  const auto         rows      = read_csv_rows(directory + "/statistics.csv");
-  const unsigned int time      = column_index(rows, "time"),
-                     energy    = column_index(rows, "kinetic_energy"),
-                     particles = column_index(rows, "particles"),
-                     centroid  = column_index(rows, "centroid_x");
-  const double m               = grain_density * M_PI * radius * radius;
-  Run          run{0, 0, 0};
-  for (unsigned int r = 1; r < rows.size(); ++r)
-  {
-    const double B =
-      std::sqrt(4 * std::stod(rows[r][energy]) / (m * lattice * lattice));
-    run.largest_error =
-      std::max(run.largest_error,
-               std::abs(B / exact_amplitude(std::stod(rows[r][time])) - 1));
-  }
-  run.grains = std::stoi(rows.back()[particles]);
-  // The rows move as much in -x as in +x: the centroid moves only by the
-  // grains carried from x = L to x = 0, L / 64 each.
-  run.crossed = static_cast<unsigned int>(std::lround(
-    (std::stod(rows[1][centroid]) - std::stod(rows.back()[centroid])) /
-    (L / (lattice * lattice))));
-  return run;
-}
 
 
 int
