@@ -395,6 +395,15 @@ end
        dry_grain,
      "Boundary conditions",
      "periodic boundary id 4"},
+    {"gmsh_periodic_faces_not_matching",
+     "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File "
+     "= " +
+       meshes +
+       "periodic_mismatch_2d.msh\n set Boundary conditions = 1: periodic, "
+       "2: periodic, 3: periodic, 4: periodic\nend\n" +
+       dry_grain,
+     "Boundary conditions",
+     "do not match"},
     {"gmsh_manifold_off_its_curve",
      "set Dimension = 2\nsubsection Mesh\n set Geometry = gmsh\n set File = " +
        meshes +
