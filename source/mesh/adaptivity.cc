@@ -340,22 +340,18 @@ namespace ImmersedGrains
   typename dealii::Triangulation<dim>::active_cell_iterator
   Adaptivity<dim>::active_cell_at(dealii::Point<dim> point) const
   {
+    for (unsigned int d = 0; d < dim; ++d)
+      if (geometry.is_periodic(d))
+        point[d] = geometry.wrap(d, point[d]);
     if (!geometry.is_box())
-    {
-      for (unsigned int d = 0; d < dim; ++d)
-        if (geometry.is_periodic(d))
-          point[d] = geometry.wrap(d, point[d]);
       return mesh_cell_at(point);
-    }
     const auto  &lo = geometry.lower_corner;
     const auto  &hi = geometry.upper_corner;
     unsigned int k = 0, stride = 1;
     for (unsigned int d = 0; d < dim; ++d)
     {
       const double length = hi[d] - lo[d];
-      if (geometry.is_periodic(d))
-        point[d] = geometry.wrap(d, point[d]);
-      else if (point[d] < lo[d] || point[d] > hi[d])
+      if (point[d] < lo[d] || point[d] > hi[d])
         return triangulation.end();
       const unsigned int n = geometry.subdivisions[d];
       k += stride * std::min(n - 1,
