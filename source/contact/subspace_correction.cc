@@ -58,10 +58,14 @@ namespace ImmersedGrains
         const Row &row = rows[subspace_rows[q]];
         GrainSlot &a   = grains[row.i];
         GrainSlot &b   = grains[row.j];
+        // In locals: the compiler cannot tell that the slots written do
+        // not alias d.
+        const double a_d = a.inverse_mass * d[q];
+        const double b_d = b.inverse_mass * d[q];
         for (unsigned int c = 0; c < dim; ++c)
         {
-          a.velocity[c] -= a.inverse_mass * d[q] * row.normal[c];
-          b.velocity[c] += b.inverse_mass * d[q] * row.normal[c];
+          a.velocity[c] -= a_d * row.normal[c];
+          b.velocity[c] += b_d * row.normal[c];
         }
       }
       glue();
@@ -132,21 +136,25 @@ namespace ImmersedGrains
            ++it)
       {
         apply_delassus(subspace_search, subspace_image, glue);
-        double curvature = 0;
+        // Sums run in locals: sum() takes an address, and an accumulator
+        // kept in memory stores on every term.
+        double local_curvature = 0;
         for (unsigned int q = 0; q < n; ++q)
-          curvature += subspace_search[q] * subspace_image[q];
+          local_curvature += subspace_search[q] * subspace_image[q];
+        double curvature = local_curvature;
         sum(&curvature, 1);
         if (!(curvature > 0))
           break;
-        const double alpha  = rz / curvature;
-        double       rz_new = 0;
+        const double alpha    = rz / curvature;
+        double       local_rz = 0;
         for (unsigned int q = 0; q < n; ++q)
         {
           subspace_solution[q] += alpha * subspace_search[q];
           subspace_residual[q] -= alpha * subspace_image[q];
-          rz_new +=
+          local_rz +=
             subspace_residual[q] * subspace_residual[q] * subspace_inverse_w[q];
         }
+        double rz_new = local_rz;
         sum(&rz_new, 1);
         const double beta = rz_new / rz;
         rz                = rz_new;
@@ -157,12 +165,13 @@ namespace ImmersedGrains
 
       // The step that minimises f along d: -grad f.d / d.N d.
       apply_delassus(subspace_solution, subspace_image, glue);
-      double along[2] = {0, 0};
+      double g_d = 0, d_image = 0;
       for (unsigned int q = 0; q < n; ++q)
       {
-        along[0] += subspace_gradient[q] * subspace_solution[q];
-        along[1] += subspace_solution[q] * subspace_image[q];
+        g_d += subspace_gradient[q] * subspace_solution[q];
+        d_image += subspace_solution[q] * subspace_image[q];
       }
+      double along[2] = {g_d, d_image};
       sum(along, 2);
       if (!(along[1] > 0) || !(along[0] < 0))
         return 0;
