@@ -30,7 +30,9 @@
 // 1.09 %); fine run, h = 100 um and dt = 125 us: <= 0.6 % (measured at
 // most 0.31 %), and its largest error at most 0.45 times the coarse run's
 // (measured 0.29; halving both the cells and the step must gain more than
-// a first-order method's 0.5).
+// a first-order method's 0.5). On two ranks the coarse run, whose discs
+// cross the ranks' boundary (the refinement study is the serial run's:
+// the ranks change no discretisation).
 // Models that miss a piece of the coupling fall far outside: the fluid
 // fed the filtered drag coefficient times its own velocity (instead of
 // the drags spread back) gives B/B0 = 0.058 at 0.08 s, the filter left out
@@ -67,8 +69,9 @@ int
 main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  const double                     coarse = largest_error("coarse", 16, 2.5e-4);
-  const double                     fine   = largest_error("fine", 32, 1.25e-4);
+  const bool   serial = Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1;
+  const double coarse = largest_error("coarse", 16, 2.5e-4);
+  const double fine   = serial ? largest_error("fine", 32, 1.25e-4) : 0.;
   if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) != 0)
     return 0;
   using shear_wave::B0;
@@ -78,9 +81,10 @@ main(int argc, char **argv)
             << exact_amplitude(0.02) / B0 << ", " << exact_amplitude(0.05) / B0
             << ", " << exact_amplitude(0.08) / B0 << '\n'
             << "h = 200 um, dt = 250 us: |B/B_exact - 1| <= 1.5 %: "
-            << (coarse <= 0.015 ? "yes" : "no") << '\n'
-            << "h = 100 um, dt = 125 us: |B/B_exact - 1| <= 0.6 %: "
-            << (fine <= 0.006 ? "yes" : "no") << '\n'
-            << "fine error <= 0.45 coarse error: "
-            << (fine <= 0.45 * coarse ? "yes" : "no") << '\n';
+            << (coarse <= 0.015 ? "yes" : "no") << '\n';
+  if (serial)
+    std::cout << "h = 100 um, dt = 125 us: |B/B_exact - 1| <= 0.6 %: "
+              << (fine <= 0.006 ? "yes" : "no") << '\n'
+              << "fine error <= 0.45 coarse error: "
+              << (fine <= 0.45 * coarse ? "yes" : "no") << '\n';
 }
