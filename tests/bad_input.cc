@@ -1,6 +1,10 @@
 // Bad input must end with a non-zero exit status, exactly one line on stderr
 // that names the file and the parameter (and the value where there is one),
-// and no output directory. Each case below is a scene with one mistake.
+// and no output directory. Each case below is a scene with one mistake, run
+// by the executable's command line in a child process
+// (command_line_in_child.h).
+#include "command_line_in_child.h"
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -523,7 +527,7 @@ end
      "nothing to simulate"},
   };
 
-  // Each case starts the executable as a singleton MPI process; Open MPI
+  // Each case runs the command line as a singleton MPI process; Open MPI
   // then starts a helper daemon unless told not to, which costs a fifth of a
   // case's time and nothing that the cases check.
   setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
@@ -539,10 +543,8 @@ end
       f << c.body << "set Output directory = " << outdir << "\n";
       (void)good_mesh;
     }
-    const std::string command = std::string(IMMERSED_GRAINS_EXECUTABLE) + " " +
-                                prm + " > stdout_" + c.name + " 2> stderr_" +
-                                c.name;
-    const int status = std::system(command.c_str());
+    const int status =
+      run_command_line_in_child({prm}, "stdout_" + c.name, "stderr_" + c.name);
 
     std::ifstream            err("stderr_" + c.name);
     std::vector<std::string> lines;

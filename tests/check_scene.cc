@@ -27,7 +27,10 @@
 // "3.55 x 10^-06": numdiff compares with an absolute tolerance of 1e-6,
 // which takes any two numbers closer than that as equal ("3.55e-06"
 // against "4.18e-06" would pass); split, the digits are compared to 1e-8
-// relative and the exponent exactly.
+// relative and the exponent exactly. Each check runs the executable's
+// command line in a child process (command_line_in_child.h).
+#include "command_line_in_child.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -103,10 +106,9 @@ check(const std::string &name,
       << "\n"
          "end\n";
   }
-  const std::string command = std::string(IMMERSED_GRAINS_EXECUTABLE) +
-                              " --check " + name + ".prm > stdout_" + name +
-                              " 2>&1";
-  const int status = std::system(command.c_str());
+  const int status = run_command_line_in_child({"--check", name + ".prm"},
+                                               "stdout_" + name,
+                                               "stdout_" + name);
   std::cout << name << ": exit status " << (status == 0 ? "0" : "non-zero")
             << ", output directory "
             << (fs::exists("out_" + name) ? "written" : "absent") << '\n';
@@ -119,7 +121,7 @@ check(const std::string &name,
 int
 main()
 {
-  // Each check starts the executable as a singleton MPI process; Open MPI
+  // Each check runs the command line as a singleton MPI process; Open MPI
   // then starts a helper daemon unless told not to, which costs a fifth of a
   // check's time and nothing that the checks look at.
   setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);

@@ -1,5 +1,7 @@
 #include <immersed_grains/contact/contact_solver.h>
 
+#include "row_kinematics.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -57,45 +59,6 @@ namespace ImmersedGrains
 {
   namespace Contact
   {
-    template <int dim>
-    template <bool with_friction>
-    void
-    ContactSolver<dim>::contact_velocity(const unsigned int k,
-                                         double            *out) const
-    {
-      const Row       &row = rows[k];
-      const GrainSlot &a   = grains[row.i];
-      const GrainSlot &b   = grains[row.j];
-      if constexpr (!with_friction)
-      {
-        double u_n = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          u_n += (b.velocity[d] - a.velocity[d]) * row.normal[d];
-        out[0] = u_n;
-      }
-      else
-      {
-        const FrictionRow &f = friction_rows[k];
-        double             spin[spin_dim], lever[dim];
-        for (unsigned int d = 0; d < spin_dim; ++d)
-          spin[d] = f.radius_i * spins[row.i].angular_velocity[d] +
-                    f.radius_j * spins[row.j].angular_velocity[d];
-        // spin x n, as in sweep_rows().
-        if constexpr (dim == 2)
-        {
-          lever[0] = -spin[0] * row.normal[1];
-          lever[1] = spin[0] * row.normal[0];
-        }
-        else
-        {
-          lever[0] = spin[1] * row.normal[2] - spin[2] * row.normal[1];
-          lever[1] = spin[2] * row.normal[0] - spin[0] * row.normal[2];
-          lever[2] = spin[0] * row.normal[1] - spin[1] * row.normal[0];
-        }
-        for (unsigned int d = 0; d < dim; ++d)
-          out[d] = b.velocity[d] - a.velocity[d] - lever[d];
-      }
-    }
 
 
 

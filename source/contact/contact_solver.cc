@@ -2,6 +2,8 @@
 
 #include <immersed_grains/contact/contact_solver.h>
 
+#include "row_kinematics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -74,39 +76,6 @@ namespace ImmersedGrains
     {
       // Wall keys live above every grain id in the second key component.
       constexpr std::uint64_t wall_key_bit = std::uint64_t(1) << 63;
-
-      // out = s x n: s an angular velocity (scalar in 2D), n in the plane.
-      template <int dim>
-      inline void
-      spin_cross(const double *s, const double *n, double *out)
-      {
-        if constexpr (dim == 2)
-        {
-          out[0] = -s[0] * n[1];
-          out[1] = s[0] * n[0];
-        }
-        else
-        {
-          out[0] = s[1] * n[2] - s[2] * n[1];
-          out[1] = s[2] * n[0] - s[0] * n[2];
-          out[2] = s[0] * n[1] - s[1] * n[0];
-        }
-      }
-
-      // out = n x p for two vectors of the space (a scalar in 2D).
-      template <int dim>
-      inline void
-      vector_cross(const double *n, const double *p, double *out)
-      {
-        if constexpr (dim == 2)
-          out[0] = n[0] * p[1] - n[1] * p[0];
-        else
-        {
-          out[0] = n[1] * p[2] - n[2] * p[1];
-          out[1] = n[2] * p[0] - n[0] * p[2];
-          out[2] = n[0] * p[1] - n[1] * p[0];
-        }
-      }
     } // namespace
 
 
@@ -634,7 +603,7 @@ namespace ImmersedGrains
       {
         const FrictionRow &f = friction_rows[k];
         double             torque[spin_dim];
-        vector_cross<dim>(row.normal, dp_t, torque);
+        internal::vector_cross<dim>(row.normal, dp_t, torque);
         SpinSlot &sa = spins[row.i];
         SpinSlot &sb = spins[row.j];
         for (unsigned int d = 0; d < spin_dim; ++d)
@@ -714,7 +683,7 @@ namespace ImmersedGrains
           for (unsigned int d = 0; d < spin_dim; ++d)
             spin[d] = f.radius_i * sa.angular_velocity[d] +
                       f.radius_j * sb.angular_velocity[d];
-          spin_cross<dim>(spin, row.normal, lever);
+          internal::spin_cross<dim>(spin, row.normal, lever);
           double u[dim], u_n = 0;
           for (unsigned int d = 0; d < dim; ++d)
           {
@@ -753,7 +722,7 @@ namespace ImmersedGrains
             p2 += p_t[d] * p_t[d];
           }
           double torque[spin_dim];
-          vector_cross<dim>(row.normal, dp_t, torque);
+          internal::vector_cross<dim>(row.normal, dp_t, torque);
           for (unsigned int d = 0; d < spin_dim; ++d)
           {
             sa.angular_velocity[d] -=
