@@ -41,44 +41,59 @@ namespace ImmersedGrains
   namespace Contact
   {
     template <int dim>
-    void
-    ContactSolver<dim>::apply_delassus(const std::vector<double>   &d,
+    template <typename Prepare>
+    double
+    ContactSolver<dim>::apply_delassus(std::vector<double>         &d,
+                                       const Prepare               &prepare,
                                        std::vector<double>         &image,
                                        const std::function<void()> &glue)
     {
       // The scratch slots hold the inverse masses (subspace_correction());
-      // their velocities are set to M^-1 H d alone.
+      // their velocities are set to M^-1 H d alone. Each slot adds up its
+      // rows' impulses in their order: the sums of a scatter over the rows,
+      // to the last bit, without a store that the next row must wait for.
       grains.swap(subspace_velocities);
-      for (GrainSlot &slot : grains)
-        for (unsigned int c = 0; c < dim; ++c)
-          slot.velocity[c] = 0;
-      const unsigned int n = subspace_rows.size();
+      const unsigned int n = subspace_geometry.size();
       for (unsigned int q = 0; q < n; ++q)
+        prepare(q);
+      const unsigned int n_slots = grains.size();
+      for (unsigned int g = 0; g < n_slots; ++g)
       {
-        const Row &row = rows[subspace_rows[q]];
-        GrainSlot &a   = grains[row.i];
-        GrainSlot &b   = grains[row.j];
-        // In locals: the compiler cannot tell that the slots written do
-        // not alias d.
-        const double a_d = a.inverse_mass * d[q];
-        const double b_d = b.inverse_mass * d[q];
-        for (unsigned int c = 0; c < dim; ++c)
+        GrainSlot   &slot = grains[g];
+        double       v[dim]{};
+        const double inverse_mass = slot.inverse_mass;
+        for (unsigned int e = subspace_incidence_start[g];
+             e < subspace_incidence_start[g + 1];
+             ++e)
         {
-          a.velocity[c] -= a_d * row.normal[c];
-          b.velocity[c] += b_d * row.normal[c];
+          // v - p n is v + (-p) n to the last bit: no branch on the side.
+          const unsigned int entry = subspace_incidence[e];
+          const double       p =
+            (entry % 2 == 0 ? -inverse_mass : inverse_mass) * d[entry / 2];
+          const double *normal = subspace_geometry[entry / 2].normal;
+          for (unsigned int c = 0; c < dim; ++c)
+            v[c] += p * normal[c];
         }
+        for (unsigned int c = 0; c < dim; ++c)
+          slot.velocity[c] = v[c];
       }
       glue();
+      // The product d.(N d) beside the gather: its chain of additions
+      // overlaps the gather's independent work.
+      double d_image = 0;
       for (unsigned int q = 0; q < n; ++q)
       {
-        const Row &row = rows[subspace_rows[q]];
-        double     u_n = 0;
+        const SubspaceRow &row = subspace_geometry[q];
+        const GrainSlot   &a   = grains[row.i];
+        const GrainSlot   &b   = grains[row.j];
+        double             u_n = 0;
         for (unsigned int c = 0; c < dim; ++c)
-          u_n += (grains[row.j].velocity[c] - grains[row.i].velocity[c]) *
-                 row.normal[c];
+          u_n += (b.velocity[c] - a.velocity[c]) * row.normal[c];
         image[q] = u_n;
+        d_image += d[q] * u_n;
       }
       grains.swap(subspace_velocities);
+      return d_image;
     }
 
 
@@ -96,14 +111,38 @@ namespace ImmersedGrains
 
       subspace_rows.clear();
       subspace_inverse_w.clear();
+      subspace_geometry.clear();
       for (unsigned int k = 0; k < rows.size(); ++k)
         if (rows[k].p_n > 0 && rows[k].inverse_w > 0)
         {
           subspace_rows.push_back(k);
           subspace_inverse_w.push_back(rows[k].inverse_w);
+          SubspaceRow packed{rows[k].i, rows[k].j, {}};
+          for (unsigned int c = 0; c < dim; ++c)
+            packed.normal[c] = rows[k].normal[c];
+          subspace_geometry.push_back(packed);
         }
       subspace_velocities  = grains;
       const unsigned int n = subspace_rows.size();
+      subspace_incidence_start.assign(grains.size() + 1, 0);
+      for (const SubspaceRow &row : subspace_geometry)
+      {
+        ++subspace_incidence_start[row.i + 1];
+        ++subspace_incidence_start[row.j + 1];
+      }
+      for (unsigned int g = 0; g < grains.size(); ++g)
+        subspace_incidence_start[g + 1] += subspace_incidence_start[g];
+      subspace_incidence.resize(2 * n);
+      {
+        std::vector<unsigned int> &next = subspace_incidence_next;
+        next.assign(subspace_incidence_start.begin(),
+                    subspace_incidence_start.end() - 1);
+        for (unsigned int q = 0; q < n; ++q)
+        {
+          subspace_incidence[next[subspace_geometry[q].i]++] = 2 * q;
+          subspace_incidence[next[subspace_geometry[q].j]++] = 2 * q + 1;
+        }
+      }
       subspace_gradient.resize(n);
       subspace_solution.assign(n, 0.);
       subspace_residual.resize(n);
@@ -131,17 +170,29 @@ namespace ImmersedGrains
       const double scale      = start[1];
       if (!(rz > 0) || !(scale > 0))
         return 0;
+      // The search direction of every iteration after the first is formed
+      // as it is scattered (apply_delassus()).
+      double     beta               = 0;
+      const auto first_direction    = [](const unsigned int) {};
+      const auto conjugate_residual = [&](const unsigned int q)
+      {
+        subspace_search[q] = subspace_residual[q] * subspace_inverse_w[q] +
+                             beta * subspace_search[q];
+      };
       for (unsigned int it = 0;
            it < parameters.subspace_iterations && rz > 1e-24 * initial_rz;
            ++it)
       {
-        apply_delassus(subspace_search, subspace_image, glue);
         // Sums run in locals: sum() takes an address, and an accumulator
         // kept in memory stores on every term.
-        double local_curvature = 0;
-        for (unsigned int q = 0; q < n; ++q)
-          local_curvature += subspace_search[q] * subspace_image[q];
-        double curvature = local_curvature;
+        double curvature = (it == 0 ? apply_delassus(subspace_search,
+                                                     first_direction,
+                                                     subspace_image,
+                                                     glue) :
+                                      apply_delassus(subspace_search,
+                                                     conjugate_residual,
+                                                     subspace_image,
+                                                     glue));
         sum(&curvature, 1);
         if (!(curvature > 0))
           break;
@@ -156,21 +207,18 @@ namespace ImmersedGrains
         }
         double rz_new = local_rz;
         sum(&rz_new, 1);
-        const double beta = rz_new / rz;
-        rz                = rz_new;
-        for (unsigned int q = 0; q < n; ++q)
-          subspace_search[q] = subspace_residual[q] * subspace_inverse_w[q] +
-                               beta * subspace_search[q];
+        beta = rz_new / rz;
+        rz   = rz_new;
       }
 
       // The step that minimises f along d: -grad f.d / d.N d.
-      apply_delassus(subspace_solution, subspace_image, glue);
-      double g_d = 0, d_image = 0;
+      const double d_image = apply_delassus(subspace_solution,
+                                            first_direction,
+                                            subspace_image,
+                                            glue);
+      double       g_d     = 0;
       for (unsigned int q = 0; q < n; ++q)
-      {
         g_d += subspace_gradient[q] * subspace_solution[q];
-        d_image += subspace_solution[q] * subspace_image[q];
-      }
       double along[2] = {g_d, d_image};
       sum(along, 2);
       if (!(along[1] > 0) || !(along[0] < 0))

@@ -502,10 +502,30 @@ namespace ImmersedGrains
         subspace_p_n;
       std::vector<GrainSlot> subspace_velocities;
 
+      // The subspace's rows packed for the conjugate gradients, which read
+      // them twice in each of their iterations.
+      struct SubspaceRow
+      {
+        unsigned int i;
+        unsigned int j;
+        double       normal[dim];
+      };
+      std::vector<SubspaceRow> subspace_geometry;
+      // For each grain slot, the subspace rows that touch it, in their
+      // order: 2 q for row q's grain i, 2 q + 1 for its partner j, from
+      // subspace_incidence_start[g] on.
+      std::vector<unsigned int> subspace_incidence_start, subspace_incidence,
+        subspace_incidence_next;
+
       /// N d on the subspace: the working velocities are set to M^-1 H d
-      /// alone, glued, read back as u_n, and restored.
-      void
-      apply_delassus(const std::vector<double>   &d,
+      /// alone, glued, read back as u_n, and restored. @p prepare(q) is
+      /// called just before d[q] is read, once per row in their order, so
+      /// that the conjugate gradients form their search direction as it is
+      /// scattered. Returns this rank's d.(N d), summed in the rows' order.
+      template <typename Prepare>
+      double
+      apply_delassus(std::vector<double>         &d,
+                     const Prepare               &prepare,
                      std::vector<double>         &image,
                      const std::function<void()> &glue);
 
