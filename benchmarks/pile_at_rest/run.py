@@ -11,8 +11,8 @@ at t = 4 s coloured by speed).
 
     benchmarks/pile_at_rest/run.py [END_TIME]
 
-About 7 min on the 2-core machine (the three runs at once, with another
-job beside them: the default 392 s, plain Gauss-Seidel 219 s, apgd 194 s).
+About 5 min on the 2-core machine (the three runs at once: the default
+252 s, plain Gauss-Seidel 229 s, apgd 200 s).
 Needs build/immersed-grains, python3-numpy and python3-matplotlib.
 """
 import csv
