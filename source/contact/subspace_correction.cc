@@ -41,10 +41,8 @@ namespace ImmersedGrains
   namespace Contact
   {
     template <int dim>
-    template <typename Prepare>
     double
-    ContactSolver<dim>::apply_delassus(std::vector<double>         &d,
-                                       const Prepare               &prepare,
+    ContactSolver<dim>::apply_delassus(const std::vector<double>   &d,
                                        std::vector<double>         &image,
                                        const std::function<void()> &glue)
     {
@@ -53,9 +51,7 @@ namespace ImmersedGrains
       // rows' impulses in their order: the sums of a scatter over the rows,
       // to the last bit, without a store that the next row must wait for.
       grains.swap(subspace_velocities);
-      const unsigned int n = subspace_geometry.size();
-      for (unsigned int q = 0; q < n; ++q)
-        prepare(q);
+      const unsigned int n       = subspace_geometry.size();
       const unsigned int n_slots = grains.size();
       for (unsigned int g = 0; g < n_slots; ++g)
       {
@@ -170,29 +166,14 @@ namespace ImmersedGrains
       const double scale      = start[1];
       if (!(rz > 0) || !(scale > 0))
         return 0;
-      // The search direction of every iteration after the first is formed
-      // as it is scattered (apply_delassus()).
-      double     beta               = 0;
-      const auto first_direction    = [](const unsigned int) {};
-      const auto conjugate_residual = [&](const unsigned int q)
-      {
-        subspace_search[q] = subspace_residual[q] * subspace_inverse_w[q] +
-                             beta * subspace_search[q];
-      };
       for (unsigned int it = 0;
            it < parameters.subspace_iterations && rz > 1e-24 * initial_rz;
            ++it)
       {
         // Sums run in locals: sum() takes an address, and an accumulator
         // kept in memory stores on every term.
-        double curvature = (it == 0 ? apply_delassus(subspace_search,
-                                                     first_direction,
-                                                     subspace_image,
-                                                     glue) :
-                                      apply_delassus(subspace_search,
-                                                     conjugate_residual,
-                                                     subspace_image,
-                                                     glue));
+        double curvature =
+          apply_delassus(subspace_search, subspace_image, glue);
         sum(&curvature, 1);
         if (!(curvature > 0))
           break;
@@ -207,16 +188,17 @@ namespace ImmersedGrains
         }
         double rz_new = local_rz;
         sum(&rz_new, 1);
-        beta = rz_new / rz;
-        rz   = rz_new;
+        const double beta = rz_new / rz;
+        rz                = rz_new;
+        for (unsigned int q = 0; q < n; ++q)
+          subspace_search[q] = subspace_residual[q] * subspace_inverse_w[q] +
+                               beta * subspace_search[q];
       }
 
       // The step that minimises f along d: -grad f.d / d.N d.
-      const double d_image = apply_delassus(subspace_solution,
-                                            first_direction,
-                                            subspace_image,
-                                            glue);
-      double       g_d     = 0;
+      const double d_image =
+        apply_delassus(subspace_solution, subspace_image, glue);
+      double g_d = 0;
       for (unsigned int q = 0; q < n; ++q)
         g_d += subspace_gradient[q] * subspace_solution[q];
       double along[2] = {g_d, d_image};

@@ -518,14 +518,10 @@ namespace ImmersedGrains
         subspace_incidence_next;
 
       /// N d on the subspace: the working velocities are set to M^-1 H d
-      /// alone, glued, read back as u_n, and restored. @p prepare(q) is
-      /// called just before d[q] is read, once per row in their order, so
-      /// that the conjugate gradients form their search direction as it is
-      /// scattered. Returns this rank's d.(N d), summed in the rows' order.
-      template <typename Prepare>
+      /// alone, glued, read back as u_n, and restored. Returns this rank's
+      /// d.(N d), summed in the rows' order.
       double
-      apply_delassus(std::vector<double>         &d,
-                     const Prepare               &prepare,
+      apply_delassus(const std::vector<double>   &d,
                      std::vector<double>         &image,
                      const std::function<void()> &glue);
 
