@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <deal.II/base/geometry_info.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -265,10 +266,41 @@ namespace ImmersedGrains
       return f;
     }
 
+    // The reference gradients @p reference mapped through the inverse
+    // Jacobian @p inverse (inverse[k][d] = dxi_k/dx_d): grad N = J^{-T}
+    // grad_xi N.
+    template <int dim, typename InverseJacobian>
+    void
+    map_gradients(const InverseJacobian   &inverse,
+                  const ScalarShapes<dim> &reference,
+                  ScalarShapes<dim>       &shapes)
+    {
+      const unsigned int n_s = reference.N.size();
+      const unsigned int n_p = reference.Np.size();
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        for (unsigned int a = 0; a < n_s; ++a)
+        {
+          double g = 0;
+          for (unsigned int k = 0; k < dim; ++k)
+            g += inverse[k][d] * reference.G[k][a];
+          shapes.G[d][a] = g;
+        }
+        for (unsigned int b = 0; b < n_p; ++b)
+        {
+          double g = 0;
+          for (unsigned int k = 0; k < dim; ++k)
+            g += inverse[k][d] * reference.Gp[k][b];
+          shapes.Gp[d][b] = g;
+        }
+      }
+    }
+
     // The gradients, weights and points of a cell of any shape under the
     // Q1 map (MappingQ1's): grad N = J^{-T} grad_xi N, JxW = det J w, with
     // J = dx/dxi at each point. A Gmsh mesh's cells that are not
-    // axis-parallel boxes take this path; boxes take scale_to_cell().
+    // axis-parallel boxes take this path; boxes take scale_to_cell(), cells
+    // on a curved boundary map_through_mapping().
     template <int dim, typename CellIterator>
     void
     map_to_cell(const CellIterator                   &cell,
@@ -283,8 +315,6 @@ namespace ImmersedGrains
       std::array<dealii::Point<dim>, n_v> X;
       for (unsigned int v = 0; v < n_v; ++v)
         X[v] = cell->vertex(v);
-      const unsigned int n_s = reference[0].N.size();
-      const unsigned int n_p = reference[0].Np.size();
       for (unsigned int q = 0; q < quadrature.size(); ++q)
       {
         dealii::Tensor<2, dim> J;
@@ -296,25 +326,28 @@ namespace ImmersedGrains
         }
         const double determinant = dealii::determinant(J);
         Assert(determinant > 0, dealii::ExcMessage("a distorted cell"));
-        JxW[q]                           = quadrature.weight(q) * determinant;
-        const dealii::Tensor<2, dim> inv = dealii::invert(J);
-        for (unsigned int d = 0; d < dim; ++d)
-        {
-          for (unsigned int a = 0; a < n_s; ++a)
-          {
-            double g = 0;
-            for (unsigned int k = 0; k < dim; ++k)
-              g += inv[k][d] * reference[q].G[k][a];
-            shapes[q].G[d][a] = g;
-          }
-          for (unsigned int b = 0; b < n_p; ++b)
-          {
-            double g = 0;
-            for (unsigned int k = 0; k < dim; ++k)
-              g += inv[k][d] * reference[q].Gp[k][b];
-            shapes[q].Gp[d][b] = g;
-          }
-        }
+        JxW[q] = quadrature.weight(q) * determinant;
+        map_gradients(dealii::invert(J), reference[q], shapes[q]);
+      }
+    }
+
+    // The gradients, weights and points of a cell with an edge on a curved
+    // boundary, under the geometry's quadratic mapping (@p mapped was
+    // reinit'ed on the cell with its quadrature points, weights and inverse
+    // Jacobians): the cell's edges on the boundary follow the curve.
+    template <int dim>
+    void
+    map_through_mapping(const dealii::FEValues<dim>          &mapped,
+                        const std::vector<ScalarShapes<dim>> &reference,
+                        std::vector<ScalarShapes<dim>>       &shapes,
+                        std::vector<double>                  &JxW,
+                        std::vector<dealii::Point<dim>>      &points)
+    {
+      for (unsigned int q = 0; q < mapped.n_quadrature_points; ++q)
+      {
+        points[q] = mapped.quadrature_point(q);
+        JxW[q]    = mapped.JxW(q);
+        map_gradients(mapped.inverse_jacobian(q), reference[q], shapes[q]);
       }
     }
 
@@ -591,12 +624,20 @@ namespace ImmersedGrains
    */
   template <int dim>
   void
-  FluidSolver<dim>::assemble_system(const bool assemble_preconditioner_matrices)
+  FluidSolver<dim>::assemble_system(const bool assemble_preconditioner_matrices,
+                                    BoundaryReactions *reactions)
   {
-    dealii::TimerOutput::Scope scope(timer, "fluid: assembly");
+    dealii::TimerOutput::Scope scope(timer,
+                                     reactions ? "fluid: boundary forces" :
+                                                 "fluid: assembly");
+    Assert(!(reactions && assemble_preconditioner_matrices),
+           dealii::ExcInternalError());
 
-    system_matrix = 0;
-    system_rhs    = 0;
+    if (!reactions)
+    {
+      system_matrix = 0;
+      system_rhs    = 0;
+    }
     if (assemble_preconditioner_matrices)
     {
       pressure_mass_matrix = 0;
@@ -640,9 +681,17 @@ namespace ImmersedGrains
 
     const std::vector<ScalarShapes<dim>> reference =
       reference_shapes(fe, dofs, quadrature);
-    std::vector<ScalarShapes<dim>>  cell_shapes = reference;
-    const bool                      cartesian   = geometry.is_cartesian();
-    const VertexFunctions<dim>      vertex      = vertex_functions(quadrature);
+    std::vector<ScalarShapes<dim>>       cell_shapes = reference;
+    const bool                           cartesian   = geometry.is_cartesian();
+    const VertexFunctions<dim>           vertex = vertex_functions(quadrature);
+    std::optional<dealii::FEValues<dim>> curved_cell_values;
+    if (geometry.has_curved_boundary())
+      curved_cell_values.emplace(mapping,
+                                 fe,
+                                 quadrature,
+                                 dealii::update_quadrature_points |
+                                   dealii::update_JxW_values |
+                                   dealii::update_inverse_jacobians);
     std::vector<double>             JxW_values(n_q);
     std::vector<dealii::Point<dim>> points(n_q);
     CellIntegrals                   integrals;
@@ -671,9 +720,30 @@ namespace ImmersedGrains
       if (!cell->is_locally_owned())
         continue;
       const unsigned int cell_number = owned_cell++;
+      if (reactions)
+      {
+        // Only the cells with a velocity DoF on one of the faces.
+        cell->get_dof_indices(dof_indices);
+        if (std::none_of(dof_indices.begin(),
+                         dof_indices.end(),
+                         [&](const dealii::types::global_dof_index i)
+                         {
+                           return std::any_of(reactions->dofs.begin(),
+                                              reactions->dofs.end(),
+                                              [i](const dealii::IndexSet &set)
+                                              { return set.is_element(i); });
+                         }))
+          continue;
+      }
       if (cartesian)
         scale_to_cell(
           cell, quadrature, reference, cell_shapes, JxW_values, points);
+      else if (geometry.is_curved(cell))
+      {
+        curved_cell_values->reinit(cell);
+        map_through_mapping(
+          *curved_cell_values, reference, cell_shapes, JxW_values, points);
+      }
       else
         map_to_cell(
           cell, quadrature, vertex, reference, cell_shapes, JxW_values, points);
@@ -764,6 +834,18 @@ namespace ImmersedGrains
           term->cell(context, integrals);
       }
 
+      if (reactions)
+      {
+        // The residual tested with the sum of the faces' shape functions
+        // of component c: -rhs_u summed over the cell's DoFs on them.
+        for (unsigned int k = 0; k < reactions->dofs.size(); ++k)
+          for (unsigned int a = 0; a < n_s; ++a)
+            for (unsigned int c = 0; c < dim; ++c)
+              if (reactions->dofs[k].is_element(
+                    dof_indices[dofs.velocity[a][c]]))
+                reactions->sums[k][c] += integrals.rhs_u[a * dim + c];
+        continue;
+      }
       fill_cell_system(
         integrals, dofs, convection_derivative, cell_matrix, cell_rhs);
       const bool direct = cell_scatter->is_direct(cell_number);
@@ -797,6 +879,12 @@ namespace ImmersedGrains
       }
     }
 
+    if (reactions)
+    {
+      for (auto &sum : reactions->sums)
+        sum = dealii::Utilities::MPI::sum(sum, mpi_communicator);
+      return;
+    }
     system_matrix.compress(dealii::VectorOperation::add);
     system_rhs.compress(dealii::VectorOperation::add);
     drag_averaged_cells =
@@ -863,9 +951,9 @@ namespace ImmersedGrains
 
 
   template void
-  FluidSolver<2>::assemble_system(bool);
+  FluidSolver<2>::assemble_system(bool, BoundaryReactions *);
   template void
-  FluidSolver<3>::assemble_system(bool);
+  FluidSolver<3>::assemble_system(bool, BoundaryReactions *);
   template FluidSolver<2>::AssemblyTermList
   FluidSolver<2>::make_assembly_terms(const ScalarDofs<2> &,
                                       double,

@@ -301,27 +301,61 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::vector<std::pair<typename dealii::DoFHandler<dim>::active_cell_iterator,
+                        dealii::Point<dim>>>
+  FluidSolver<dim>::owned_cells_around(const dealii::Point<dim> &point) const
+  {
+    // Through the mapping with a tolerance, not CellAccessor::point_inside():
+    // that tests the exact unit cell after MappingQ1's inverse, which
+    // refuses a point on a vertex or a face of a curved or skewed cell from
+    // every side (a probe there read 0).
+    std::vector<
+      std::pair<typename dealii::DoFHandler<dim>::active_cell_iterator,
+                dealii::Point<dim>>>
+      around;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        auto box = cell->bounding_box();
+        // Room for an edge that bulges out of its vertices' box.
+        box.extend(0.25 * box.side_length(0));
+        if (!box.point_inside(point))
+          continue;
+        try
+        {
+          const dealii::Point<dim> reference =
+            mapping.transform_real_to_unit_cell(cell, point);
+          if (dealii::GeometryInfo<dim>::is_inside_unit_cell(reference, 1e-10))
+            around.emplace_back(cell, reference);
+        }
+        catch (const typename dealii::Mapping<dim>::ExcTransformationFailed &)
+        {
+          // Far outside this cell.
+        }
+      }
+    return around;
+  }
+
+
+  template <int dim>
   double
   FluidSolver<dim>::pressure_at(const dealii::Point<dim> &point) const
   {
     double sum = 0, count = 0;
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned() && cell->point_inside(point))
-      {
-        const dealii::Point<dim> reference =
-          mapping.transform_real_to_unit_cell(cell, point);
-        const dealii::Quadrature<dim> one_point(reference);
-        dealii::FEValues<dim>         fe_values(mapping,
-                                        fe,
-                                        one_point,
-                                        dealii::update_values);
-        fe_values.reinit(cell);
-        std::vector<double> value(1);
-        fe_values[dealii::FEValuesExtractors::Scalar(dim)].get_function_values(
-          solution, value);
-        sum += value[0];
-        count += 1;
-      }
+    for (const auto &[cell, reference] : owned_cells_around(point))
+    {
+      const dealii::Quadrature<dim> one_point(reference);
+      dealii::FEValues<dim>         fe_values(mapping,
+                                      fe,
+                                      one_point,
+                                      dealii::update_values);
+      fe_values.reinit(cell);
+      std::vector<double> value(1);
+      fe_values[dealii::FEValuesExtractors::Scalar(dim)].get_function_values(
+        solution, value);
+      sum += value[0];
+      count += 1;
+    }
     sum   = dealii::Utilities::MPI::sum(sum, mpi_communicator);
     count = dealii::Utilities::MPI::sum(count, mpi_communicator);
     return count > 0 ? sum / count : 0.0;
@@ -334,15 +368,12 @@ namespace ImmersedGrains
   {
     double             sum = 0, count = 0;
     MixtureValues<dim> values;
-    for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_locally_owned() && cell->point_inside(point))
-      {
-        const dealii::Point<dim> reference =
-          mapping.transform_real_to_unit_cell(cell, point);
-        mixture_fields->evaluate(cell, {point}, {reference}, time, values);
-        sum += values.fluid_fraction[0];
-        count += 1;
-      }
+    for (const auto &[cell, reference] : owned_cells_around(point))
+    {
+      mixture_fields->evaluate(cell, {point}, {reference}, time, values);
+      sum += values.fluid_fraction[0];
+      count += 1;
+    }
     sum   = dealii::Utilities::MPI::sum(sum, mpi_communicator);
     count = dealii::Utilities::MPI::sum(count, mpi_communicator);
     return count > 0 ? sum / count : 1.0;
@@ -389,8 +420,63 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::vector<dealii::Tensor<1, dim>>
+  FluidSolver<dim>::boundary_forces(
+    const std::vector<dealii::types::boundary_id> &ids)
+  {
+    // The residual's rows are -R(u_h; v), and for v a face's shape
+    // function R(u_h; v) is the integral of phi sigma n . v over the faces
+    // (the term the weak form leaves out where the velocity is given):
+    // the reaction, with the sign of the force on the boundary. Where the
+    // id's faces meet another boundary whose velocity is given, the DoFs
+    // of the corners carry that boundary's reaction too (3 % of the force
+    // on the floor of tilted_channel_poiseuille_2d): there the traction is
+    // integrated.
+    const dealii::FEValuesExtractors::Vector velocities(0);
+    const dealii::ComponentMask          mask = fe.component_mask(velocities);
+    std::set<dealii::types::boundary_id> given;
+    for (const auto type :
+         {BoundaryType::wall, BoundaryType::slip, BoundaryType::velocity})
+      for (const auto id : geometry.boundary_ids(type))
+        given.insert(id);
+    std::vector<dealii::Tensor<1, dim>> forces(ids.size());
+    BoundaryReactions                   reactions;
+    std::vector<unsigned int>           by_reaction;
+    for (unsigned int k = 0; k < ids.size(); ++k)
+    {
+      dealii::IndexSet on_id =
+        dealii::DoFTools::extract_boundary_dofs(dof_handler, mask, {ids[k]});
+      std::set<dealii::types::boundary_id> others = given;
+      others.erase(ids[k]);
+      const bool meets_others =
+        !others.empty() &&
+        dealii::Utilities::MPI::max(
+          static_cast<int>(!(on_id & dealii::DoFTools::extract_boundary_dofs(
+                                       dof_handler, mask, others))
+                              .is_empty()),
+          mpi_communicator) > 0;
+      if (meets_others)
+        forces[k] = traction_force(ids[k]);
+      else
+      {
+        reactions.dofs.push_back(std::move(on_id));
+        by_reaction.push_back(k);
+      }
+    }
+    if (!by_reaction.empty())
+    {
+      reactions.sums.resize(by_reaction.size());
+      assemble_system(false, &reactions);
+      for (unsigned int j = 0; j < by_reaction.size(); ++j)
+        forces[by_reaction[j]] = reactions.sums[j];
+    }
+    return forces;
+  }
+
+
+  template <int dim>
   dealii::Tensor<1, dim>
-  FluidSolver<dim>::boundary_force(const dealii::types::boundary_id id) const
+  FluidSolver<dim>::traction_force(const dealii::types::boundary_id id) const
   {
     const dealii::FEValuesExtractors::Vector velocities(0);
     const dealii::FEValuesExtractors::Scalar pressure(dim);
@@ -1243,7 +1329,7 @@ namespace ImmersedGrains
 
   template <int dim>
   double
-  FluidSolver<dim>::integrate_fluid_fraction() const
+  FluidSolver<dim>::integrate_fluid_fraction(double *mesh_volume) const
   {
     const dealii::QGauss<dim> quadrature(3);
     dealii::FEValues<dim>     fe_values(mapping,
@@ -1252,7 +1338,7 @@ namespace ImmersedGrains
                                     dealii::update_quadrature_points |
                                       dealii::update_JxW_values);
     MixtureValues<dim>        values;
-    double                    integral = 0;
+    double                    integral = 0, volume = 0;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
       {
@@ -1263,8 +1349,13 @@ namespace ImmersedGrains
                                  time,
                                  values);
         for (unsigned int q = 0; q < quadrature.size(); ++q)
+        {
           integral += values.fluid_fraction[q] * fe_values.JxW(q);
+          volume += fe_values.JxW(q);
+        }
       }
+    if (mesh_volume)
+      *mesh_volume = dealii::Utilities::MPI::sum(volume, mpi_communicator);
     return dealii::Utilities::MPI::sum(integral, mpi_communicator);
   }
 

@@ -161,7 +161,10 @@ namespace ImmersedGrains
         "columns boundary_force_<id>_x, _y[, _z], the integral of -phi "
         "sigma n over those faces [N; N/m in 2D], sigma = -p I + mu (grad u "
         "+ grad u^T) with p the pressure without its hydrostatic part, n "
-        "the fluid's outward normal.");
+        "the fluid's outward normal. An id that meets no other boundary "
+        "with a given velocity (an obstacle) gets the reaction of the "
+        "discrete momentum equation, which converges with the flow's "
+        "order; others the traction integrated over the faces.");
       prm.declare_entry(
         "Boundary fluxes",
         "",

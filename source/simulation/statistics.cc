@@ -216,12 +216,14 @@ namespace ImmersedGrains
   void
   Simulation<dim>::set_fluid_statistics()
   {
-    const double volume = geometry.volume();
     // The coupling knows its fluid fraction node by node; prescribed
-    // fields are integrated by quadrature.
+    // fields are integrated by quadrature, over the mesh as mapped (not
+    // the coarse mesh's volume: a curved boundary's changes with
+    // refinement).
+    double       volume       = geometry.volume();
     const double fluid_volume = coupling && coupling_parameters.two_way ?
                                   coupling->fluid_volume() :
-                                  fluid->integrate_fluid_fraction();
+                                  fluid->integrate_fluid_fraction(&volume);
     statistics.set("dofs", fluid->n_dofs());
     statistics.set("fluid_volume", fluid_volume);
     if (!pressure_drop_points.empty())
@@ -231,13 +233,12 @@ namespace ImmersedGrains
     statistics.set("solid_volume",
                    coupling ? coupling->solid_volume() : volume - fluid_volume);
     static const char *const axes[] = {"_x", "_y", "_z"};
-    for (const auto id : boundary_force_ids)
-    {
-      const auto force = fluid->boundary_force(id);
+    const auto forces = fluid->boundary_forces(boundary_force_ids);
+    for (unsigned int k = 0; k < boundary_force_ids.size(); ++k)
       for (unsigned int d = 0; d < dim; ++d)
-        statistics.set("boundary_force_" + std::to_string(id) + axes[d],
-                       force[d]);
-    }
+        statistics.set("boundary_force_" +
+                         std::to_string(boundary_force_ids[k]) + axes[d],
+                       forces[k][d]);
     for (const auto id : boundary_flux_ids)
       statistics.set("boundary_flux_" + std::to_string(id),
                      fluid->boundary_flux(id));

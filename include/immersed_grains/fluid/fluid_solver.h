@@ -197,13 +197,20 @@ namespace ImmersedGrains
     fluid_fraction_at(const dealii::Point<dim> &point) const;
 
     /**
-     * The force of the fluid on the boundary parts with id @p id (per unit
-     * depth in 2D): -integral of phi sigma n, with sigma = -p I + mu (grad
-     * u + grad u^T), p without its hydrostatic part and n the fluid's
-     * outward normal. Collective.
+     * The force of the fluid on the boundary parts with each id of @p ids
+     * (per unit depth in 2D), -integral of phi sigma n with sigma = -p I +
+     * mu (grad u + grad u^T), p without its hydrostatic part and n the
+     * fluid's outward normal. Where the id's faces meet no other boundary
+     * with a given velocity (an obstacle), it is the reaction of the
+     * discrete momentum equation: the residual of the current solution
+     * tested with the velocity shape functions of the id's faces, summed
+     * (one assembly pass over the cells that touch those faces), which
+     * converges with the flow's own order; elsewhere the traction of the
+     * discrete solution integrated over the faces, which converges like
+     * its gradient. Collective.
      */
-    dealii::Tensor<1, dim>
-    boundary_force(dealii::types::boundary_id id) const;
+    std::vector<dealii::Tensor<1, dim>>
+    boundary_forces(const std::vector<dealii::types::boundary_id> &ids);
 
     /**
      * The fluid's volume flux out through the boundary parts with id @p id
@@ -230,9 +237,11 @@ namespace ImmersedGrains
     double
     driven_speed() const;
 
-    /** Integral of the fluid fraction over the mesh. */
+    /** The integral of the fluid fraction over the mesh, and where
+     *  @p mesh_volume is given the mesh's volume under the mapping (a
+     *  curved boundary's volume changes with refinement). Collective. */
     double
-    integrate_fluid_fraction() const;
+    integrate_fluid_fraction(double *mesh_volume = nullptr) const;
 
     dealii::types::global_dof_index
     n_dofs() const;
@@ -275,8 +284,33 @@ namespace ImmersedGrains
     void
     make_constraints();
 
+    // The locally owned cells that hold @p point (more than one on their
+    // faces), each with the point's reference coordinates.
+    std::vector<
+      std::pair<typename dealii::DoFHandler<dim>::active_cell_iterator,
+                dealii::Point<dim>>>
+    owned_cells_around(const dealii::Point<dim> &point) const;
+
+    // -integral of phi sigma n over the faces with id @p id.
+    dealii::Tensor<1, dim>
+    traction_force(dealii::types::boundary_id id) const;
+
+    // The residual's velocity rows summed over the DoFs of some boundary
+    // ids: boundary_forces().
+    struct BoundaryReactions
+    {
+      // The velocity DoFs on each id's faces.
+      std::vector<dealii::IndexSet> dofs;
+      // Per id, the sum of the residual's rows of each component.
+      std::vector<dealii::Tensor<1, dim>> sums;
+    };
+
+    // The system of the current iterate, or with @p reactions only the
+    // residual's sums over the boundary DoFs that it names (the system
+    // untouched).
     void
-    assemble_system(bool assemble_preconditioner_matrices);
+    assemble_system(bool               assemble_preconditioner_matrices,
+                    BoundaryReactions *reactions = nullptr);
 
     // The terms of the weak form that the scene needs (fluid_assembly.cc),
     // those integrated at quadrature points and those added per cell.

@@ -152,10 +152,23 @@ namespace ImmersedGrains
 
     /** The mapping of the mesh's cells: MappingCartesian where every cell
      *  is an axis-parallel box (exact there, with constant Jacobians and a
-     *  closed-form inverse, a fraction of MappingQ1's cost), MappingQ1
-     *  elsewhere. */
+     *  closed-form inverse, a fraction of MappingQ1's cost), a quadratic
+     *  map (MappingQ of degree 2, the velocity's degree) where the mesh has
+     *  curved boundaries (`Mesh/Manifolds`), MappingQ1 elsewhere. */
     const dealii::Mapping<dim> &
     mapping() const;
+
+    /** Whether the mesh has curved boundaries (`Mesh/Manifolds`), so that
+     *  mapping() is quadratic. */
+    bool
+    has_curved_boundary() const;
+
+    /** Whether an edge of @p cell lies on a curved boundary: the cells
+     *  whose quadratic map differs from their bilinear (trilinear) one;
+     *  every other cell's map is MappingQ1's. */
+    bool
+    is_curved(
+      const typename dealii::Triangulation<dim>::cell_iterator &cell) const;
 
     /** Adds the boundaries grains meet (wall, slip and velocity ids) to
      *  @p walls: the box's planes, or the boundary faces of a Gmsh mesh as
