@@ -1,18 +1,25 @@
 #!/usr/bin/python3
 """Discharge of the 2D silo of prm/silo_discharge_2d.prm through orifices of
-D = 6 to 14 mean grain diameters, and Beverloo's law fitted to the rates.
+D = 6 to 14 mean grain diameters, and Beverloo's law fitted to the rates;
+with --immersed the silo in water of prm/silo_discharge_immersed_2d.prm.
 
-    /usr/bin/python3 benchmarks/silo/run.py [--ranks N] [--widths 0.04,0.06]
+    /usr/bin/python3 benchmarks/silo/run.py [--immersed] [--ranks N]
+        [--widths 0.04,0.06] [--jobs 2]
 
 Each width gets its own mesh (prm/meshes/silo_2d.py) and run (output in
-benchmarks/results/silo/D<width>/). The discharge rate is the slope of
+benchmarks/results/silo[_immersed]/D<width>/), from the same settled fill
+(prm/packings/silo_2d.txt). The discharge rate is the slope of
 grains_removed against time while between 10 % and 50 % of the grains have
 left (the bed still deep above the orifice). Beverloo's law in 2D,
 W = C rho_b sqrt(g) (D - k d)^(3/2) (per unit depth), is fitted as a line
 of W^(2/3) against D, which gives k; the exponent fitted freely shows how
-well 3/2 describes the rates. Writes results.csv and beverloo.png there.
+well 3/2 describes the rates; immersed, C is stated for the grains'
+buoyant weight, g' = g (1 - rho_f/rho_s), so that it equals the dry C
+where the law holds with g' for g. Writes results.csv and beverloo.png
+there.
 """
 import argparse
+import concurrent.futures
 import csv
 import math
 import os
@@ -23,27 +30,31 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(
     __file__))))
-OUT = os.path.join(ROOT, "benchmarks", "results", "silo")
-d_mean, rho_s, g = 0.01, 2500.0, 9.81
+d_mean, rho_s, rho_f, g = 0.01, 2500.0, 1000.0, 9.81
 # Mean area of a disc of radius uniform in [4, 6] mm: pi (r^2 mean).
 area = math.pi * (0.005 ** 2 + 0.002 ** 2 / 12)
 
 
-def run(width, ranks):
-    folder = os.path.join(OUT, "D%g" % width)
+def run(out, width, ranks, immersed):
+    folder = os.path.join(out, "D%g" % width)
     os.makedirs(folder, exist_ok=True)
     mesh = os.path.join(folder, "silo.msh")
     with open(mesh, "w") as f:
         # Cells of 1 cm, so that every width is a centred whole number of
         # them.
         subprocess.run([sys.executable,
-                        os.path.join(ROOT, "prm", "meshes", "silo_2d.py"),
-                        str(width), "0.4", "0.8", "0.01"], stdout=f,
+                        os.path.join(ROOT, "prm", "meshes", "silo_2d.py")]
+                       + (["--open-top"] if immersed else [])
+                       + [str(width), "0.4", "0.8", "0.01"], stdout=f,
                        check=True)
-    with open(os.path.join(ROOT, "prm", "silo_discharge_2d.prm")) as f:
+    scene = "silo_discharge_immersed_2d" if immersed else "silo_discharge_2d"
+    with open(os.path.join(ROOT, "prm", scene + ".prm")) as f:
         text = f.read()
-    text = text.replace("set File                = meshes/silo_2d.msh",
-                        "set File                = silo.msh")
+    for name in ["meshes/silo_2d.msh", "meshes/silo_immersed_2d.msh"]:
+        text = text.replace("set File                = " + name,
+                            "set File                = silo.msh")
+    text = text.replace("packings/silo_2d.txt", os.path.join(
+        ROOT, "prm", "packings", "silo_2d.txt"))
     text = text.replace("set Write fields every = 25",
                         "set Write fields every = 0")
     text += "set Output directory = %s\n" % os.path.join(folder, "output")
@@ -70,20 +81,30 @@ def run(width, ranks):
 
 def main():
     parser = argparse.ArgumentParser()
+    parser.add_argument("--immersed", action="store_true",
+                        help="the silo in water")
     parser.add_argument("--ranks", type=int, default=1)
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="runs at once")
     parser.add_argument("--widths", default="0.06,0.08,0.1,0.12,0.14")
     args = parser.parse_args()
+    out = os.path.join(ROOT, "benchmarks", "results",
+                       "silo_immersed" if args.immersed else "silo")
+    # The weight that drives the grains: buoyant in water.
+    g_drive = g * (1 - rho_f / rho_s) if args.immersed else g
     widths = [float(w) for w in args.widths.split(",")]
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
+        runs = list(pool.map(
+            lambda w: run(out, w, args.ranks, args.immersed), widths))
     results = []
-    for w in widths:
-        n0, rate, wall = run(w, args.ranks)
+    for w, (n0, rate, wall) in zip(widths, runs):
         mass_rate = rate * area * rho_s  # kg/(m s)
         results.append((w, n0, rate, mass_rate, wall))
         print("D = %.2f m (%.0f d): %.0f grains, %.1f grains/s, "
               "W = %.3f kg/(m s), %.0f s" % (w, w / d_mean, n0, rate,
                                               mass_rate, wall), flush=True)
-    os.makedirs(OUT, exist_ok=True)
-    with open(os.path.join(OUT, "results.csv"), "w") as f:
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "results.csv"), "w") as f:
         f.write("D,grains,rate_grains_per_s,W_kg_per_m_s,wall_time\n")
         for row in results:
             f.write(",".join("%.6g" % x for row_x in [row] for x in row_x)
@@ -93,12 +114,13 @@ def main():
     ok = np.isfinite(W)
     slope, intercept = np.polyfit(D[ok], W[ok] ** (2 / 3), 1)
     k = -intercept / slope / d_mean
-    c_rho = slope ** 1.5 / math.sqrt(g)  # C rho_b
+    c_rho = slope ** 1.5 / math.sqrt(g_drive)  # C rho_b
     # The exponent free: W = a (D - k d)^n with k from the 3/2 fit.
     n = np.polyfit(np.log(D[ok] - k * d_mean), np.log(W[ok]), 1)[0]
-    print("Beverloo, exponent 3/2: k = %.2f, C rho_b = %.0f kg/m^3, "
-          "C = %.3f with rho_b = %.0f (packing 0.8); free exponent %.2f"
-          % (k, c_rho, c_rho / (0.8 * rho_s), 0.8 * rho_s, n))
+    print("Beverloo, exponent 3/2, g = %.2f m/s^2: k = %.2f, "
+          "C rho_b = %.0f kg/m^3, C = %.3f with rho_b = %.0f (packing 0.8); "
+          "free exponent %.2f"
+          % (g_drive, k, c_rho, c_rho / (0.8 * rho_s), 0.8 * rho_s, n))
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -112,7 +134,7 @@ def main():
         ax.set_ylabel("W$^{2/3}$  [(kg/(m s))$^{2/3}$]")
         ax.legend()
         fig.tight_layout()
-        fig.savefig(os.path.join(OUT, "beverloo.png"), dpi=120)
+        fig.savefig(os.path.join(out, "beverloo.png"), dpi=120)
     except ImportError:
         pass
 

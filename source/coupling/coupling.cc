@@ -373,6 +373,7 @@ namespace ImmersedGrains
     dealii::TimerOutput::Scope scope(timer, "coupling: solid fraction");
     const auto                &particles = grains.particle_handler();
     const auto                &layout    = grains.layout();
+    removed_volume_at_projection         = grains.removed_volume();
     projection->project(
       [&](const auto &cell, std::vector<GrainSample<dim>> &samples)
       {
@@ -976,6 +977,14 @@ namespace ImmersedGrains
   Coupling<dim>::solid_volume() const
   {
     return projection->integral();
+  }
+
+
+  template <int dim>
+  double
+  Coupling<dim>::removed_since_projection(const Grains<dim> &grains) const
+  {
+    return grains.removed_volume() - removed_volume_at_projection;
   }
 
 

@@ -987,7 +987,11 @@ namespace ImmersedGrains
       drift = {largest[0], largest[1]};
     }
 
-    const unsigned long n_leaving = leaving.size();
+    const unsigned long n_leaving      = leaving.size();
+    double              volume_leaving = 0;
+    for (const auto &p : leaving)
+      volume_leaving +=
+        grain_volume<dim>(p->get_properties()[properties.radius]);
     // Owned grains that stay, and the fixed ones among them, on all ranks.
     std::vector<unsigned long> before = {
       particles.n_locally_owned_particles() - n_leaving, n_fixed, n_elsewhere};
@@ -1040,6 +1044,8 @@ namespace ImmersedGrains
     const unsigned long removed =
       dealii::Utilities::MPI::sum<unsigned long>(n_leaving, comm);
     removed_total += removed;
+    if (removed > 0)
+      removed_volume_total += dealii::Utilities::MPI::sum(volume_leaving, comm);
     return removed;
   }
 
@@ -1240,6 +1246,14 @@ namespace ImmersedGrains
   Grains<dim>::set_removed(const unsigned long n)
   {
     removed_total = n;
+  }
+
+
+  template <int dim>
+  double
+  Grains<dim>::removed_volume() const
+  {
+    return removed_volume_total;
   }
 
 

@@ -263,10 +263,13 @@ namespace ImmersedGrains
     if (coupling && s.solid_volume > 0)
     {
       // Conservation of the projection: what the fluid sees against what
-      // the grains are.
+      // the grains were when it was made (those that left through an open
+      // boundary in the step's moves included).
+      const double projected_grains =
+        s.solid_volume + coupling->removed_since_projection(*grains);
       statistics.set("solid_volume_error",
-                     std::abs(coupling->solid_volume() - s.solid_volume) /
-                       s.solid_volume);
+                     std::abs(coupling->solid_volume() - projected_grains) /
+                       projected_grains);
       statistics.set("max_reynolds", coupling->max_reynolds());
     }
     if (cloud_analysis)

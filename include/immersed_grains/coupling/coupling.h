@@ -190,6 +190,12 @@ namespace ImmersedGrains
     double
     solid_volume() const;
 
+    /** The grains' volume that the last project() saw and that has left
+     *  through open boundaries since (@p grains the projected ones):
+     *  solid_volume() less this is what the grains now are. */
+    double
+    removed_since_projection(const Grains<dim> &grains) const;
+
     /** Integral of the fluid fraction the fluid sees (evaluate()). */
     double
     fluid_volume() const;
@@ -331,6 +337,8 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> assumed_velocity;
     // The share of what it owed that the fluid's step repays.
     double repaid_share = 1;
+    // Grains::removed_volume() when project() ran.
+    double removed_volume_at_projection = 0;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 

@@ -348,6 +348,12 @@ namespace ImmersedGrains
     void
     set_removed(unsigned long n);
 
+    /** The volume of the grains that left through open boundaries since
+     *  this object was made (not kept across a restart): differences of
+     *  it tell what left between two instants. */
+    double
+    removed_volume() const;
+
     double
     mass(double radius) const;
 
@@ -390,7 +396,8 @@ namespace ImmersedGrains
     double min_cell_size = 0;
 
     GrainStepArrays<dim> arrays;
-    unsigned long        removed_total = 0;
+    unsigned long        removed_total        = 0;
+    double               removed_volume_total = 0;
     StraightPathDrift    drift;
 
     /** The other ranks' cells near each owned cell (update_partition()). */
