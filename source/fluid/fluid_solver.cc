@@ -316,9 +316,13 @@ namespace ImmersedGrains
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
       {
-        auto box = cell->bounding_box();
-        // Room for an edge that bulges out of its vertices' box.
-        box.extend(0.25 * box.side_length(0));
+        auto   box     = cell->bounding_box();
+        double longest = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          longest = std::max(longest, box.side_length(d));
+        // Room for an edge that bulges out of its vertices' box, across
+        // the box's shortest side as well.
+        box.extend(0.25 * longest);
         if (!box.point_inside(point))
           continue;
         try
