@@ -84,8 +84,12 @@ namespace ImmersedGrains
       auto &c                  = arrays.contact;
       c.velocity               = c.start_velocity;
     }
+    coupling.project_departed(grains, dt);
     coupling.prepare_fluid_drag(grains, fluid, dt, previous_dt);
     report.fluid = fluid.solve_time_step(time + dt, dt);
+    // Taken out of the mixture by this step (a step that failed above
+    // is taken again with them).
+    grains.forget_departed();
     coupling.set_grain_forces(grains, fluid, dt);
     grains.compute_free_velocities(dt);
     // Grains that this step would move too far take equal sub-steps

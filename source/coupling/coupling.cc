@@ -259,7 +259,9 @@ namespace ImmersedGrains
     if (!parameters.two_way)
       return;
     // The simulation owns both; the fluid only borrows this object.
-    // Grains meet inflow faces as walls: no solid flux passes there.
+    // Grains meet inflow faces as walls, and leave through open ones
+    // whole, when their centre crosses (project_departed()): no solid flux
+    // passes any boundary.
     fluid.set_mixture_fields(std::shared_ptr<const MixtureFields<dim>>(
                                this, [](const MixtureFields<dim> *) {}),
                              false);
@@ -392,6 +394,28 @@ namespace ImmersedGrains
       },
       // The implicit coupling replaces the projected flux.
       !(parameters.two_way && parameters.implicit_coupling));
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::project_departed(Grains<dim> &grains, const double dt)
+  {
+    if (!parameters.two_way)
+      return;
+    dealii::TimerOutput::Scope scope(timer, "coupling: solid fraction");
+    std::vector<
+      std::pair<typename dealii::Triangulation<dim>::active_cell_iterator,
+                GrainSample<dim>>>
+      samples;
+    for (const auto &g : grains.departed())
+    {
+      GrainSample<dim> s{};
+      s.reference_location = g.reference;
+      s.volume             = g.volume;
+      samples.emplace_back(g.cell, s);
+    }
+    projection->project_sink(samples, dt);
   }
 
 

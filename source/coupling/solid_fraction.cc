@@ -85,6 +85,9 @@ namespace ImmersedGrains
                  parameters.smoothing_length,
                  parameters.smoothing_length > 0);
     fraction = filter.make_ghosted_vector();
+    // Projected again for each step (project_sink()).
+    sink      = {};
+    sink_rate = 0;
     if (parameters.smoothing_length > 0)
       felt = filter.make_ghosted_vector();
     for (auto &f : flux)
@@ -222,6 +225,41 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  void
+  SolidFraction<dim>::project_sink(
+    const std::vector<
+      std::pair<typename dealii::Triangulation<dim>::active_cell_iterator,
+                GrainSample<dim>>> &grains,
+    const double                    dt)
+  {
+    const MPI_Comm comm = filter.get_dof_handler().get_communicator();
+    sink_rate           = 0;
+    if (dealii::Utilities::MPI::sum(grains.size(), comm) == 0)
+      return;
+    auto               rhs = filter.make_owned_vector();
+    const unsigned int n   = filter.get_fe().n_dofs_per_cell();
+    std::vector<dealii::types::global_dof_index> indices(n);
+    dealii::Vector<double>                       cell_volume(n);
+    for (const auto &[cell, g] : grains)
+    {
+      const auto shape =
+        HelmholtzFilter<dim>::shape_values(g.reference_location);
+      for (unsigned int j = 0; j < n; ++j)
+        cell_volume(j) = g.volume * shape[j];
+      filter.add_cell_contribution(filter.dof_cell(cell),
+                                   cell_volume,
+                                   indices,
+                                   rhs);
+    }
+    rhs.compress(dealii::VectorOperation::add);
+    if (sink.size() != fraction.size())
+      sink = filter.make_ghosted_vector();
+    filter.solve(rhs, sink);
+    sink_rate = 1 / dt;
+  }
+
+
+  template <int dim>
   double
   SolidFraction<dim>::integral() const
   {
@@ -300,6 +338,12 @@ namespace ImmersedGrains
       values.solid_scale[q]      = scale(solid[q], values.fluid_fraction[q]);
       values.drag_coefficient[q] = 0;
       values.mass_source[q]      = 0;
+    }
+    if (sink_rate > 0)
+    {
+      evaluate_field(sink);
+      for (unsigned int q = 0; q < n_points; ++q)
+        values.mass_source[q] = -sink_rate * field_values[q];
     }
     for (unsigned int d = 0; d < dim; ++d)
     {

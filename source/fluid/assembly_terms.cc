@@ -360,9 +360,9 @@ namespace ImmersedGrains
     const MixtureFields<dim>    &mixture_fields,
     dealii::Function<dim>       &open_pressure,
     const double                 time,
-    const bool                   solid_crosses_inflow)
+    const bool                   solid_crosses_boundaries)
       : geometry(geometry)
-      , solid_crosses_inflow(solid_crosses_inflow)
+      , solid_crosses_boundaries(solid_crosses_boundaries)
       , mixture_fields(mixture_fields)
       , open_pressure(open_pressure)
       , time(time)
@@ -387,11 +387,11 @@ namespace ImmersedGrains
   template <int dim>
   bool
   BoundaryFluxTerm<dim>::needed(const Geometry<dim> &geometry,
-                                const bool           solid_crosses_inflow)
+                                const bool           solid_crosses_boundaries)
   {
     for (const auto &[id, type] : geometry.boundary_types)
       if (type == BoundaryType::open ||
-          (type == BoundaryType::velocity && solid_crosses_inflow))
+          (type == BoundaryType::velocity && solid_crosses_boundaries))
         return true;
     return false;
   }
@@ -410,7 +410,7 @@ namespace ImmersedGrains
         continue;
       const BoundaryType type = geometry.boundary_type(face->boundary_id());
       if (type != BoundaryType::open &&
-          !(type == BoundaryType::velocity && solid_crosses_inflow))
+          !(type == BoundaryType::velocity && solid_crosses_boundaries))
         continue;
       fe_face_values.reinit(cell, face_no);
       mixture_fields.evaluate(cell,
@@ -420,9 +420,10 @@ namespace ImmersedGrains
                               mixture);
       for (unsigned int q = 0; q < quadrature.size(); ++q)
       {
-        const auto  &n       = fe_face_values.normal_vector(q);
-        const double JxW     = fe_face_values.JxW(q);
-        const double outflux = mixture.solid_flux[q] * n;
+        const auto  &n   = fe_face_values.normal_vector(q);
+        const double JxW = fe_face_values.JxW(q);
+        const double outflux =
+          solid_crosses_boundaries ? mixture.solid_flux[q] * n : 0.0;
         const double p_open =
           type == BoundaryType::open ?
             open_pressure.value(fe_face_values.quadrature_point(q)) :
@@ -434,9 +435,11 @@ namespace ImmersedGrains
             integrals.rhs_u[a * dim + c] -=
               (mixture.fluid_fraction[q] * p_open * (N * n[c])) * JxW;
         }
-        for (unsigned int b = 0; b < dofs.pressure.size(); ++b)
-          integrals.rhs_p[b] -=
-            (-fe_face_values.shape_value(dofs.pressure[b], q) * outflux) * JxW;
+        if (outflux != 0)
+          for (unsigned int b = 0; b < dofs.pressure.size(); ++b)
+            integrals.rhs_p[b] -=
+              (-fe_face_values.shape_value(dofs.pressure[b], q) * outflux) *
+              JxW;
       }
     }
   }

@@ -935,7 +935,7 @@ namespace ImmersedGrains
       add(std::make_unique<GrainDragTerm<dim>>(
             *point_drag_source, fe, dofs, cell_averaged_drag, max_beta),
           false);
-    if (BoundaryFluxTerm<dim>::needed(geometry, solid_crosses_inflow))
+    if (BoundaryFluxTerm<dim>::needed(geometry, solid_crosses_boundaries))
       add(std::make_unique<BoundaryFluxTerm<dim>>(
             mapping,
             fe,
@@ -944,7 +944,7 @@ namespace ImmersedGrains
             *mixture_fields,
             *parameters.open_boundary_pressure,
             time,
-            solid_crosses_inflow),
+            solid_crosses_boundaries),
           false);
     return list;
   }

@@ -231,11 +231,11 @@ namespace ImmersedGrains
   void
   FluidSolver<dim>::set_mixture_fields(
     std::shared_ptr<const MixtureFields<dim>> fields,
-    const bool                                solid_crosses_inflow)
+    const bool                                solid_crosses_boundaries)
   {
     mixture_fields             = fields;
     fields_prescribed          = false;
-    this->solid_crosses_inflow = solid_crosses_inflow;
+    this->solid_crosses_boundaries = solid_crosses_boundaries;
   }
 
 

@@ -295,6 +295,14 @@ namespace ImmersedGrains
   void
   Grains<dim>::prepare_for_mesh_change()
   {
+    // The departed grains' cells may not survive: kept as real positions.
+    if (!departed_need_cells)
+      for (auto &g : departed_grains)
+      {
+        g.reference = mapping.transform_unit_to_real_cell(g.cell, g.reference);
+        g.cell = typename dealii::Triangulation<dim>::active_cell_iterator();
+      }
+    departed_need_cells = true;
     particles.prepare_for_coarsening_and_refinement();
   }
 
@@ -473,6 +481,7 @@ namespace ImmersedGrains
   GrainStepReport
   Grains<dim>::advance(const double dt)
   {
+    forget_departed();
     gather();
     compute_free_velocities(dt);
     GrainStepReport report = resolve_contacts(dt);
@@ -990,8 +999,14 @@ namespace ImmersedGrains
     const unsigned long n_leaving      = leaving.size();
     double              volume_leaving = 0;
     for (const auto &p : leaving)
-      volume_leaving +=
+    {
+      const double volume =
         grain_volume<dim>(p->get_properties()[properties.radius]);
+      volume_leaving += volume;
+      // Its cell and reference location are still those before the move.
+      departed_grains.push_back(
+        {p->get_surrounding_cell(), p->get_reference_location(), volume});
+    }
     // Owned grains that stay, and the fixed ones among them, on all ranks.
     std::vector<unsigned long> before = {
       particles.n_locally_owned_particles() - n_leaving, n_fixed, n_elsewhere};
@@ -1246,6 +1261,84 @@ namespace ImmersedGrains
   Grains<dim>::set_removed(const unsigned long n)
   {
     removed_total = n;
+  }
+
+
+  template <int dim>
+  const std::vector<DepartedGrain<dim>> &
+  Grains<dim>::departed()
+  {
+    if (!departed_need_cells)
+      return departed_grains;
+    departed_need_cells = false;
+    // Every rank searches its cells for every position: the region a grain
+    // left from may have moved to another rank with the mesh. The closest
+    // cell wins (the unit cell's distance, 0 inside), ties to the lowest
+    // rank, so that each grain is counted once.
+    std::vector<std::pair<dealii::Point<dim>, double>> mine;
+    for (const auto &g : departed_grains)
+      mine.emplace_back(g.reference, g.volume);
+    std::vector<std::pair<dealii::Point<dim>, double>> all;
+    for (const auto &list : dealii::Utilities::MPI::all_gather(comm, mine))
+      all.insert(all.end(), list.begin(), list.end());
+    const std::size_t   n = all.size();
+    std::vector<double> distance(n, std::numeric_limits<double>::max());
+    departed_grains.assign(n, {});
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+      {
+        auto   box     = cell->bounding_box();
+        double longest = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          longest = std::max(longest, box.side_length(d));
+        box.extend(0.25 * longest);
+        for (std::size_t k = 0; k < n; ++k)
+          if (box.point_inside(all[k].first))
+          {
+            const dealii::Point<dim> reference =
+              reference_point(cell, all[k].first);
+            const double d =
+              dealii::GeometryInfo<dim>::distance_to_unit_cell(reference);
+            if (d < distance[k])
+            {
+              distance[k]        = d;
+              departed_grains[k] = {
+                cell,
+                dealii::GeometryInfo<dim>::project_to_unit_cell(reference),
+                all[k].second};
+            }
+          }
+      }
+    std::vector<double> closest(n);
+    dealii::Utilities::MPI::min(dealii::ArrayView<const double>(distance),
+                                comm,
+                                dealii::ArrayView<double>(closest));
+    const unsigned int  rank = dealii::Utilities::MPI::this_mpi_process(comm);
+    const unsigned int  n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+    std::vector<double> owner(n);
+    for (std::size_t k = 0; k < n; ++k)
+      owner[k] = distance[k] == closest[k] &&
+                     closest[k] < std::numeric_limits<double>::max() ?
+                   rank :
+                   n_ranks;
+    dealii::Utilities::MPI::min(dealii::ArrayView<const double>(owner),
+                                comm,
+                                dealii::ArrayView<double>(owner));
+    std::vector<DepartedGrain<dim>> found;
+    for (std::size_t k = 0; k < n; ++k)
+      if (owner[k] == rank)
+        found.push_back(departed_grains[k]);
+    departed_grains = std::move(found);
+    return departed_grains;
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::forget_departed()
+  {
+    departed_grains.clear();
+    departed_need_cells = false;
   }
 
 

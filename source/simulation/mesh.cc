@@ -123,6 +123,11 @@ namespace ImmersedGrains
       }
       coupling->project(*grains);
     }
+    // The last row's fluid volume as the new mesh holds it: the grains
+    // projected anew, with those that left after that row's projection.
+    previous_fluid_volume = coupling && coupling_parameters.two_way ?
+                              coupling->fluid_volume() - departed_after_row :
+                              std::numeric_limits<double>::quiet_NaN();
     update_shortest_cell_edge();
   }
 

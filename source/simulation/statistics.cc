@@ -87,6 +87,7 @@ namespace ImmersedGrains
       // The mixture's fields (set_fluid_statistics()).
       {"dofs",
        "fluid_volume",
+       "fluid_volume_balance",
        "pressure_drop",
        "solid_volume",
        "solid_volume_error",
@@ -226,6 +227,29 @@ namespace ImmersedGrains
                                   fluid->integrate_fluid_fraction(&volume);
     statistics.set("dofs", fluid->n_dofs());
     statistics.set("fluid_volume", fluid_volume);
+    {
+      // The fluid gained in the domain over the step against what flowed
+      // in through open and inflow faces; with grains leaving, the water
+      // that replaces them (Coupling::project_departed()).
+      double net_outflow = 0, crossing = 0;
+      for (const auto &[id, type] : geometry.boundary_types)
+        if (type == BoundaryType::open || type == BoundaryType::velocity)
+        {
+          const double flux = fluid->boundary_flux(id);
+          net_outflow += flux;
+          crossing += std::abs(flux);
+        }
+      const double dt = statistics.get("dt");
+      const double imbalance =
+        fluid_volume - previous_fluid_volume + dt * net_outflow;
+      statistics.set("fluid_volume_balance",
+                     std::isfinite(imbalance) && dt * crossing > 0 ?
+                       imbalance / (dt * crossing) :
+                       0.0);
+      previous_fluid_volume = fluid_volume;
+      departed_after_row =
+        coupling && grains ? coupling->removed_since_projection(*grains) : 0;
+    }
     if (!pressure_drop_points.empty())
       statistics.set("pressure_drop",
                      fluid->pressure_at(pressure_drop_points[0]) -

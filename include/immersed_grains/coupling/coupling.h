@@ -101,6 +101,17 @@ namespace ImmersedGrains
     void
     project(const Grains<dim> &grains);
 
+    /**
+     * The grains that left through open boundaries since the last fluid
+     * step (Grains::departed()) as the fluid's volume sink over the step
+     * @p dt (SolidFraction::project_sink()): the water that replaces them.
+     * Their solid flux does not cross the open faces (attach()), so
+     * without it the mixture would lose their volume unreplaced.
+     * Collective.
+     */
+    void
+    project_departed(Grains<dim> &grains, double dt);
+
     /** @p previous_dt, the last fluid step's length (0 before the first):
      *  what the fluid owes the grains is repaid at most at the rate at
      *  which it arose, a share dt / previous_dt when the step shrinks. */

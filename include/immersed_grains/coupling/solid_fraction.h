@@ -90,6 +90,23 @@ namespace ImmersedGrains
               std::vector<GrainSample<dim>> &)> &samples,
             bool                                 with_flux = true);
 
+    /**
+     * The mixture's volume sink of grains that left through open
+     * boundaries: their volumes V_k projected like phi_s (the same filter)
+     * from where each was last inside, divided by the step @p dt, is the
+     * mass_source -r of the fluid's continuity over the next step: the
+     * water that takes their place, as much as their volume in all (the
+     * projection conserves it). Without any grain (on any rank) the sink
+     * is zero. @p grains: this rank's, each in a locally owned cell
+     * (their velocities are not read). Collective.
+     */
+    void
+    project_sink(
+      const std::vector<
+        std::pair<typename dealii::Triangulation<dim>::active_cell_iterator,
+                  GrainSample<dim>>> &grains,
+      double                          dt);
+
     /** Integral of phi_s over the mesh. */
     double
     integral() const;
@@ -195,6 +212,10 @@ namespace ImmersedGrains
     // With_mean_diameter: sum (V_i / d_i) N_j projected, and filtered once
     // more like felt; the grains' smallest and largest diameter.
     typename HelmholtzFilter<dim>::Vector surface, felt_surface;
+    // project_sink(): the departed grains' projected volume and 1 / dt
+    // (0: no sink).
+    typename HelmholtzFilter<dim>::Vector sink;
+    double                                sink_rate = 0;
     double       smallest_diameter = 0, largest_diameter = 0;
     unsigned int clamped = 0;
   };

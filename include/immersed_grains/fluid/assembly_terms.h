@@ -317,10 +317,12 @@ namespace ImmersedGrains
 
 
   /**
-   * Open faces: the weakly imposed pressure <phi p_open, v.n>, and the
-   * solid flux that leaves, -<q, s.n>. Velocity faces: that flux too where
-   * the solid crosses them (prescribed mixture fields); grains meet them as
-   * walls, so with grains no solid flux passes there.
+   * Open faces: the weakly imposed pressure <phi p_open, v.n>. Open and
+   * velocity faces: the solid flux that leaves, -<q, s.n>, where the solid
+   * crosses them (prescribed mixture fields). Grains meet velocity faces
+   * as walls and leave through open ones whole when their centre crosses,
+   * their volume then taken out as a sink: no solid flux of theirs passes
+   * a boundary.
    */
   template <int dim>
   class BoundaryFluxTerm : public AssemblyTerm<dim>
@@ -333,18 +335,18 @@ namespace ImmersedGrains
                      const MixtureFields<dim>    &mixture_fields,
                      dealii::Function<dim>       &open_pressure,
                      double                       time,
-                     bool                         solid_crosses_inflow);
+                     bool                         solid_crosses_boundaries);
     void
     cell(const CellContext<dim> &, CellIntegrals &) const override;
 
     /** Whether any face of the geometry is open, or carries a velocity
      * that the solid crosses. */
     static bool
-    needed(const Geometry<dim> &geometry, bool solid_crosses_inflow);
+    needed(const Geometry<dim> &geometry, bool solid_crosses_boundaries);
 
   private:
     const Geometry<dim>                         &geometry;
-    const bool                                   solid_crosses_inflow;
+    const bool                                   solid_crosses_boundaries;
     const MixtureFields<dim>                    &mixture_fields;
     dealii::Function<dim>                       &open_pressure;
     const double                                 time;

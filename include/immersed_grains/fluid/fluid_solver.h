@@ -115,11 +115,13 @@ namespace ImmersedGrains
     void
     load_state(std::istream &in);
 
-    /** @p solid_crosses_inflow: whether the solid flux of @p fields
-     * passes through inflow (velocity) faces; grains meet them as walls. */
+    /** @p solid_crosses_boundaries: whether the solid flux of @p fields
+     * passes through open and inflow (velocity) faces, as a prescribed
+     * flux does; grains meet inflow faces as walls and leave through open
+     * ones whole, as a volume sink (mass_source), so none of theirs. */
     void
     set_mixture_fields(std::shared_ptr<const MixtureFields<dim>> fields,
-                       bool solid_crosses_inflow = true);
+                       bool solid_crosses_boundaries = true);
 
     /**
      * Grains' implicit drag (none by default): at each grain's centre
@@ -437,7 +439,7 @@ namespace ImmersedGrains
     bool fields_prescribed = true;
     // Whether the mixture's solid flux passes through inflow faces
     // (set_mixture_fields()).
-    bool solid_crosses_inflow = true;
+    bool solid_crosses_boundaries = true;
 
     // Samples the open-face pressure at the faces' vertices.
     void

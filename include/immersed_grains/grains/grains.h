@@ -198,6 +198,16 @@ namespace ImmersedGrains
     set_statistics(Statistics &statistics) const;
   };
 
+  /** A grain that left through an open boundary, where it last was
+   *  inside the mesh (Grains::departed()). */
+  template <int dim>
+  struct DepartedGrain
+  {
+    typename dealii::Triangulation<dim>::active_cell_iterator cell;
+    dealii::Point<dim> reference; // in cell
+    double             volume;
+  };
+
   /**
    * The grain population on a Particles::ParticleHandler and its dry
    * dynamics: gravity, external forces and (hooks for) implicit drag, then
@@ -354,6 +364,21 @@ namespace ImmersedGrains
     double
     removed_volume() const;
 
+    /**
+     * The grains that left through open boundaries in the moves since the
+     * last forget_departed() (the coupling takes their volume out of the
+     * mixture: Coupling::project_departed()), each in the locally owned
+     * cell it was last in. After a mesh change they are found again in
+     * the new cells (collective then: a grain may now lie in another
+     * rank's cell, and is listed there).
+     */
+    const std::vector<DepartedGrain<dim>> &
+    departed();
+
+    /** Empties that list (before the step's moves). */
+    void
+    forget_departed();
+
     double
     mass(double radius) const;
 
@@ -395,10 +420,14 @@ namespace ImmersedGrains
     /// its old one, which under MPI are owned or ghost cells.
     double min_cell_size = 0;
 
-    GrainStepArrays<dim> arrays;
-    unsigned long        removed_total        = 0;
-    double               removed_volume_total = 0;
-    StraightPathDrift    drift;
+    GrainStepArrays<dim>            arrays;
+    unsigned long                   removed_total        = 0;
+    double                          removed_volume_total = 0;
+    std::vector<DepartedGrain<dim>> departed_grains;
+    // Since the last mesh change, departed_grains hold real positions in
+    // their reference field and no cell: departed() finds their cells.
+    bool              departed_need_cells = false;
+    StraightPathDrift drift;
 
     /** The other ranks' cells near each owned cell (update_partition()). */
     typename DistributedContacts<dim>::PartitionHalo
