@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -1330,6 +1331,57 @@ namespace ImmersedGrains
         found.push_back(departed_grains[k]);
     departed_grains = std::move(found);
     return departed_grains;
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::save_departed(std::ostream &out) const
+  {
+    out << std::hexfloat;
+    for (const auto &g : departed_grains)
+    {
+      const dealii::Point<dim> x =
+        departed_need_cells ?
+          g.reference :
+          mapping.transform_unit_to_real_cell(g.cell, g.reference);
+      for (unsigned int d = 0; d < dim; ++d)
+        out << x[d] << ' ';
+      out << g.volume << '\n';
+    }
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::load_departed(std::istream &in)
+  {
+    if (!departed_need_cells)
+      for (auto &g : departed_grains)
+      {
+        g.reference = mapping.transform_unit_to_real_cell(g.cell, g.reference);
+        g.cell = typename dealii::Triangulation<dim>::active_cell_iterator();
+      }
+    departed_need_cells = true;
+    std::string line;
+    while (std::getline(in, line))
+    {
+      std::istringstream fields(line);
+      DepartedGrain<dim> g;
+      std::string        word;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        fields >> word;
+        g.reference[d] = std::strtod(word.c_str(), nullptr);
+      }
+      fields >> word;
+      g.volume = std::strtod(word.c_str(), nullptr);
+      AssertThrow(fields,
+                  dealii::ExcMessage("Checkpoint: a departed grain's line "
+                                     "cannot be read: '" +
+                                     line + "'"));
+      departed_grains.push_back(g);
+    }
   }
 
 

@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 namespace ImmersedGrains
 {
@@ -47,6 +48,14 @@ namespace ImmersedGrains
         ".txt");
       grains->save_contact_memory(out);
       AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
+      // Grains that left in the last step and whose volume the next fluid
+      // step takes out of the mixture (Coupling::project_departed()).
+      std::ofstream departed(
+        directory + "/departed_" +
+        std::to_string(dealii::Utilities::MPI::this_mpi_process(comm)) +
+        ".txt");
+      grains->save_departed(departed);
+      AssertThrow(departed, dealii::ExcMessage("Cannot write " + directory));
     }
     field_output->series().save(directory + "/fields_xdmf.txt");
     particle_output->series().save(directory + "/particles_xdmf.txt");
@@ -227,6 +236,8 @@ namespace ImmersedGrains
         << retries_taken << ' ' << breakup_time << '\n';
     out << "grains_removed " << std::hexfloat
         << static_cast<double>(grains ? grains->n_removed() : 0) << '\n';
+    out << "fluid_volume_books " << std::hexfloat << previous_fluid_volume
+        << ' ' << departed_after_row << '\n';
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
@@ -317,6 +328,12 @@ namespace ImmersedGrains
     // Absent before grains could leave through a mesh's open boundary
     // counted so: the restored row holds the count.
     const auto removed = optional_line("grains_removed", 1);
+    // Absent before fluid_volume_balance: its first row after the resume
+    // is then 0.
+    const auto books = optional_line("fluid_volume_books", 2);
+    previous_fluid_volume =
+      books.empty() ? std::numeric_limits<double>::quiet_NaN() : books[0];
+    departed_after_row = books.empty() ? 0 : books[1];
     statistics.load_values(in);
     if (grains)
       grains->set_removed(static_cast<unsigned long>(
@@ -349,6 +366,20 @@ namespace ImmersedGrains
                                  ".txt");
           grains->load_contact_memory(contacts);
         }
+      // Rank 0 reads every rank's departed grains; departed() finds their
+      // cells on whichever rank owns them now. (Absent from checkpoints
+      // written before the sink existed: none then.)
+      std::stringstream departed;
+      if (me == 0)
+        for (unsigned int r = 0; r < saved_ranks; ++r)
+        {
+          std::ifstream file(directory + "/departed_" + std::to_string(r) +
+                             ".txt");
+          // (Inserting an empty or missing file would fail the stream.)
+          if (file && file.peek() != std::ifstream::traits_type::eof())
+            departed << file.rdbuf();
+        }
+      grains->load_departed(departed);
     }
   }
 

@@ -379,6 +379,17 @@ namespace ImmersedGrains
     void
     forget_departed();
 
+    /** That list for a checkpoint: this rank's grains, a line each (the
+     *  position where each was last inside, and its volume). */
+    void
+    save_departed(std::ostream &out) const;
+
+    /** Adds the grains of @p in (one or more ranks' lines); collective
+     *  (call on every rank, with an empty stream where there is nothing
+     *  to read): departed() finds their cells. */
+    void
+    load_departed(std::istream &in);
+
     double
     mass(double radius) const;
 
