@@ -4,7 +4,7 @@ D = 6 to 14 mean grain diameters, and Beverloo's law fitted to the rates;
 with --immersed the silo in water of prm/silo_discharge_immersed_2d.prm.
 
     /usr/bin/python3 benchmarks/silo/run.py [--immersed] [--ranks N]
-        [--widths 0.04,0.06] [--jobs 2]
+        [--widths 0.04,0.06] [--jobs 2] [--cell 0.005]
 
 Each width gets its own mesh (prm/meshes/silo_2d.py) and run (output in
 benchmarks/results/silo[_immersed]/D<width>/), from the same settled fill
@@ -35,17 +35,17 @@ d_mean, rho_s, rho_f, g = 0.01, 2500.0, 1000.0, 9.81
 area = math.pi * (0.005 ** 2 + 0.002 ** 2 / 12)
 
 
-def run(out, width, ranks, immersed):
+def run(out, width, ranks, immersed, cell):
     folder = os.path.join(out, "D%g" % width)
     os.makedirs(folder, exist_ok=True)
     mesh = os.path.join(folder, "silo.msh")
     with open(mesh, "w") as f:
-        # Cells of 1 cm, so that every width is a centred whole number of
-        # them.
+        # Cells of 1 cm (--cell), so that every width is a centred whole
+        # number of them.
         subprocess.run([sys.executable,
                         os.path.join(ROOT, "prm", "meshes", "silo_2d.py")]
                        + (["--open-top"] if immersed else [])
-                       + [str(width), "0.4", "0.8", "0.01"], stdout=f,
+                       + [str(width), "0.4", "0.8", str(cell)], stdout=f,
                        check=True)
     scene = "silo_discharge_immersed_2d" if immersed else "silo_discharge_2d"
     with open(os.path.join(ROOT, "prm", scene + ".prm")) as f:
@@ -87,15 +87,21 @@ def main():
     parser.add_argument("--jobs", type=int, default=1,
                         help="runs at once")
     parser.add_argument("--widths", default="0.06,0.08,0.1,0.12,0.14")
+    parser.add_argument("--cell", type=float, default=0.01,
+                        help="the cells' size [m]: the widths and the bin "
+                        "must be whole numbers of it (results in a folder "
+                        "named with it unless 0.01)")
     args = parser.parse_args()
     out = os.path.join(ROOT, "benchmarks", "results",
-                       "silo_immersed" if args.immersed else "silo")
+                       ("silo_immersed" if args.immersed else "silo")
+                       + ("" if args.cell == 0.01 else "_cell%g" % args.cell))
     # The weight that drives the grains: buoyant in water.
     g_drive = g * (1 - rho_f / rho_s) if args.immersed else g
     widths = [float(w) for w in args.widths.split(",")]
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         runs = list(pool.map(
-            lambda w: run(out, w, args.ranks, args.immersed), widths))
+            lambda w: run(out, w, args.ranks, args.immersed, args.cell),
+            widths))
     results = []
     for w, (n0, rate, wall) in zip(widths, runs):
         mass_rate = rate * area * rho_s  # kg/(m s)
@@ -109,6 +115,8 @@ def main():
         for row in results:
             f.write(",".join("%.6g" % x for row_x in [row] for x in row_x)
                     + "\n")
+    if len(results) < 3:
+        return  # too few widths for Beverloo's law
     D = np.array([r[0] for r in results])
     W = np.array([r[3] for r in results])
     ok = np.isfinite(W)
