@@ -233,8 +233,8 @@ namespace ImmersedGrains
     std::shared_ptr<const MixtureFields<dim>> fields,
     const bool                                solid_crosses_boundaries)
   {
-    mixture_fields             = fields;
-    fields_prescribed          = false;
+    mixture_fields                 = fields;
+    fields_prescribed              = false;
     this->solid_crosses_boundaries = solid_crosses_boundaries;
   }
 
@@ -316,14 +316,7 @@ namespace ImmersedGrains
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
       {
-        auto   box     = cell->bounding_box();
-        double longest = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          longest = std::max(longest, box.side_length(d));
-        // Room for an edge that bulges out of its vertices' box, across
-        // the box's shortest side as well.
-        box.extend(0.25 * longest);
-        if (!box.point_inside(point))
+        if (!cell_search_box(*cell).point_inside(point))
           continue;
         try
         {

@@ -1288,11 +1288,7 @@ namespace ImmersedGrains
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())
       {
-        auto   box     = cell->bounding_box();
-        double longest = 0;
-        for (unsigned int d = 0; d < dim; ++d)
-          longest = std::max(longest, box.side_length(d));
-        box.extend(0.25 * longest);
+        const auto box = cell_search_box(*cell);
         for (std::size_t k = 0; k < n; ++k)
           if (box.point_inside(all[k].first))
           {

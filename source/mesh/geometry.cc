@@ -1109,6 +1109,23 @@ namespace ImmersedGrains
   }
 
 
+  template <int dim>
+  dealii::BoundingBox<dim>
+  cell_search_box(const dealii::CellAccessor<dim> &cell)
+  {
+    auto   box     = cell.bounding_box();
+    double longest = 0;
+    for (unsigned int d = 0; d < dim; ++d)
+      longest = std::max(longest, box.side_length(d));
+    box.extend(0.25 * longest);
+    return box;
+  }
+
+
   template class Geometry<2>;
   template class Geometry<3>;
+  template dealii::BoundingBox<2>
+  cell_search_box(const dealii::CellAccessor<2> &);
+  template dealii::BoundingBox<3>
+  cell_search_box(const dealii::CellAccessor<3> &);
 } // namespace ImmersedGrains

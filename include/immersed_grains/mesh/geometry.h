@@ -1,10 +1,12 @@
 #ifndef immersed_grains_mesh_geometry_h
 #define immersed_grains_mesh_geometry_h
 
+#include <deal.II/base/bounding_box.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/fe/mapping.h>
+#include <deal.II/grid/tria_accessor.h>
 
 #include <immersed_grains/contact/walls.h>
 #include <immersed_grains/parameters.h>
@@ -40,6 +42,16 @@ namespace ImmersedGrains
 
   std::string
   to_string(BoundaryType type);
+
+  /**
+   * The box in which to look for points of @p cell before inverting its
+   * mapping: its vertices' bounding box widened by a quarter of its
+   * longest side, room for an edge that bulges out of its vertices' box
+   * (a curved boundary), across the box's shortest side as well.
+   */
+  template <int dim>
+  dealii::BoundingBox<dim>
+  cell_search_box(const dealii::CellAccessor<dim> &cell);
 
   /**
    * The domain: a box (`Geometry = box`: `Lower corner`, `Upper corner`,
