@@ -296,14 +296,8 @@ namespace ImmersedGrains
   void
   Grains<dim>::prepare_for_mesh_change()
   {
-    // The departed grains' cells may not survive: kept as real positions.
-    if (!departed_need_cells)
-      for (auto &g : departed_grains)
-      {
-        g.reference = mapping.transform_unit_to_real_cell(g.cell, g.reference);
-        g.cell = typename dealii::Triangulation<dim>::active_cell_iterator();
-      }
-    departed_need_cells = true;
+    // The departed grains' cells may not survive.
+    keep_departed_as_positions();
     particles.prepare_for_coarsening_and_refinement();
   }
 
@@ -1332,6 +1326,20 @@ namespace ImmersedGrains
 
   template <int dim>
   void
+  Grains<dim>::keep_departed_as_positions()
+  {
+    if (!departed_need_cells)
+      for (auto &g : departed_grains)
+      {
+        g.reference = mapping.transform_unit_to_real_cell(g.cell, g.reference);
+        g.cell = typename dealii::Triangulation<dim>::active_cell_iterator();
+      }
+    departed_need_cells = true;
+  }
+
+
+  template <int dim>
+  void
   Grains<dim>::save_departed(std::ostream &out) const
   {
     out << std::hexfloat;
@@ -1352,13 +1360,7 @@ namespace ImmersedGrains
   void
   Grains<dim>::load_departed(std::istream &in)
   {
-    if (!departed_need_cells)
-      for (auto &g : departed_grains)
-      {
-        g.reference = mapping.transform_unit_to_real_cell(g.cell, g.reference);
-        g.cell = typename dealii::Triangulation<dim>::active_cell_iterator();
-      }
-    departed_need_cells = true;
+    keep_departed_as_positions();
     std::string line;
     while (std::getline(in, line))
     {

@@ -482,6 +482,12 @@ namespace ImmersedGrains
       const typename dealii::Triangulation<dim>::active_cell_iterator &cell,
       const dealii::Point<dim>                                        &x) const;
 
+    /** The departed grains as real positions, their cells to be found
+     *  again by departed() (before the mesh changes, or when more are
+     *  read from a checkpoint). */
+    void
+    keep_departed_as_positions();
+
     /** Puts @p grains back into the ParticleHandler (local, no sort). */
     void
     reinsert(const std::vector<StoredGrain> &grains);
