@@ -290,11 +290,9 @@ namespace ImmersedGrains
     std::string                             boundary_force_text;
     std::vector<dealii::types::boundary_id> boundary_flux_ids;
     // The last row's fluid_volume, for fluid_volume_balance: after a mesh
-    // change, the same grains' on the new mesh (NaN at the start, and
-    // after a mesh change without grains); and the volume of the grains
-    // that left in that row's step, which its fluid_volume still held.
+    // change, the same grains' (and departed grains') on the new mesh (NaN
+    // at the start, and after a mesh change without grains).
     double previous_fluid_volume = std::numeric_limits<double>::quiet_NaN();
-    double departed_after_row    = 0;
     std::string                                             boundary_flux_text;
     std::vector<std::pair<std::string, dealii::Point<dim>>> probes;
     std::string                                             probe_text;

@@ -49,7 +49,7 @@ namespace ImmersedGrains
         throw FluidStepFailure(message.str());
       }
     }
-    coupling.project(grains);
+    coupling.project(grains, dt);
     // Grains packed beyond 1 - Minimum fluid fraction: the fluid sees the
     // minimum there. Said when it starts, counted every step.
     report.clamped_nodes = coupling.solid_fraction().n_clamped();
@@ -87,9 +87,9 @@ namespace ImmersedGrains
     coupling.project_departed(grains, dt);
     coupling.prepare_fluid_drag(grains, fluid, dt, previous_dt);
     report.fluid = fluid.solve_time_step(time + dt, dt);
-    // Taken out of the mixture by this step (a step that failed above
-    // is taken again with them).
-    grains.forget_departed();
+    // What this step took out of the mixture (a step that failed above
+    // is taken again with all of it).
+    grains.drain_departed(dt);
     coupling.set_grain_forces(grains, fluid, dt);
     grains.compute_free_velocities(dt);
     // Grains that this step would move too far take equal sub-steps

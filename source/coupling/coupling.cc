@@ -5,6 +5,8 @@
 #include <immersed_grains/grains/grains.h>
 #include <immersed_grains/parameters.h>
 
+#include <map>
+
 namespace ImmersedGrains
 {
   template <int dim>
@@ -370,15 +372,40 @@ namespace ImmersedGrains
 
   template <int dim>
   void
-  Coupling<dim>::project(const Grains<dim> &grains)
+  Coupling<dim>::project(Grains<dim> &grains, const double dt)
   {
     dealii::TimerOutput::Scope scope(timer, "coupling: solid fraction");
     const auto                &particles = grains.particle_handler();
     const auto                &layout    = grains.layout();
     removed_volume_at_projection         = grains.removed_volume();
+    // What is left of the departed grains after this step, by cell.
+    std::map<std::pair<int, int>, std::vector<GrainSample<dim>>> remnants;
+    double                                                       held = 0;
+    for (const auto &g : grains.departed())
+    {
+      GrainSample<dim> s{};
+      s.reference_location = g.reference;
+      s.volume             = g.volume - std::min(g.volume, g.rate * dt);
+      s.diameter           = g.diameter;
+      if (s.volume <= 0)
+        continue;
+      held += s.volume;
+      remnants[{g.cell->level(), g.cell->index()}].push_back(s);
+    }
+    departed_in_projection =
+      dealii::Utilities::MPI::sum(held, triangulation.get_communicator());
+
     projection->project(
       [&](const auto &cell, std::vector<GrainSample<dim>> &samples)
       {
+        if (!remnants.empty())
+        {
+          const auto found = remnants.find({cell->level(), cell->index()});
+          if (found != remnants.end())
+            samples.insert(samples.end(),
+                           found->second.begin(),
+                           found->second.end());
+        }
         for (const auto &p : particles.particles_in_cell(cell))
         {
           const auto       props = p.get_properties();
@@ -412,7 +439,7 @@ namespace ImmersedGrains
     {
       GrainSample<dim> s{};
       s.reference_location = g.reference;
-      s.volume             = g.volume;
+      s.volume             = std::min(g.volume, g.rate * dt);
       samples.emplace_back(g.cell, s);
     }
     projection->project_sink(samples, dt);
@@ -1008,7 +1035,8 @@ namespace ImmersedGrains
   double
   Coupling<dim>::removed_since_projection(const Grains<dim> &grains) const
   {
-    return grains.removed_volume() - removed_volume_at_projection;
+    return grains.removed_volume() - removed_volume_at_projection +
+           departed_in_projection;
   }
 
 

@@ -999,8 +999,20 @@ namespace ImmersedGrains
         grain_volume<dim>(p->get_properties()[properties.radius]);
       volume_leaving += volume;
       // Its cell and reference location are still those before the move.
-      departed_grains.push_back(
-        {p->get_surrounding_cell(), p->get_reference_location(), volume});
+      // It crosses its own diameter at its speed: so long does its volume
+      // take to leave the mixture.
+      const auto   props = p->get_properties();
+      const double r     = props[properties.radius];
+      double       speed = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        speed +=
+          dealii::Utilities::fixed_power<2>(props[properties.velocity + d]);
+      speed = std::sqrt(speed);
+      departed_grains.push_back({p->get_surrounding_cell(),
+                                 p->get_reference_location(),
+                                 volume,
+                                 volume * std::max(speed, 1e-12) / (2 * r),
+                                 2 * r});
     }
     // Owned grains that stay, and the fixed ones among them, on all ranks.
     std::vector<unsigned long> before = {
@@ -1270,10 +1282,11 @@ namespace ImmersedGrains
     // left from may have moved to another rank with the mesh. The closest
     // cell wins (the unit cell's distance, 0 inside), ties to the lowest
     // rank, so that each grain is counted once.
-    std::vector<std::pair<dealii::Point<dim>, double>> mine;
+    std::vector<std::pair<dealii::Point<dim>, std::vector<double>>> mine;
     for (const auto &g : departed_grains)
-      mine.emplace_back(g.reference, g.volume);
-    std::vector<std::pair<dealii::Point<dim>, double>> all;
+      mine.emplace_back(g.reference,
+                        std::vector<double>{g.volume, g.rate, g.diameter});
+    std::vector<std::pair<dealii::Point<dim>, std::vector<double>>> all;
     for (const auto &list : dealii::Utilities::MPI::all_gather(comm, mine))
       all.insert(all.end(), list.begin(), list.end());
     const std::size_t   n = all.size();
@@ -1296,7 +1309,9 @@ namespace ImmersedGrains
               departed_grains[k] = {
                 cell,
                 dealii::GeometryInfo<dim>::project_to_unit_cell(reference),
-                all[k].second};
+                all[k].second[0],
+                all[k].second[1],
+                all[k].second[2]};
             }
           }
       }
@@ -1351,7 +1366,7 @@ namespace ImmersedGrains
           mapping.transform_unit_to_real_cell(g.cell, g.reference);
       for (unsigned int d = 0; d < dim; ++d)
         out << x[d] << ' ';
-      out << g.volume << '\n';
+      out << g.volume << ' ' << g.rate << ' ' << g.diameter << '\n';
     }
   }
 
@@ -1374,12 +1389,30 @@ namespace ImmersedGrains
       }
       fields >> word;
       g.volume = std::strtod(word.c_str(), nullptr);
+      fields >> word;
+      g.rate = std::strtod(word.c_str(), nullptr);
+      fields >> word;
+      g.diameter = std::strtod(word.c_str(), nullptr);
       AssertThrow(fields,
                   dealii::ExcMessage("Checkpoint: a departed grain's line "
                                      "cannot be read: '" +
                                      line + "'"));
       departed_grains.push_back(g);
     }
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::drain_departed(const double dt)
+  {
+    for (auto &g : departed_grains)
+      g.volume -= std::min(g.volume, g.rate * dt);
+    departed_grains.erase(std::remove_if(departed_grains.begin(),
+                                         departed_grains.end(),
+                                         [](const DepartedGrain<dim> &g)
+                                         { return g.volume <= 0; }),
+                          departed_grains.end());
   }
 
 

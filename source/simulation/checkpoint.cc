@@ -237,7 +237,7 @@ namespace ImmersedGrains
     out << "grains_removed " << std::hexfloat
         << static_cast<double>(grains ? grains->n_removed() : 0) << '\n';
     out << "fluid_volume_books " << std::hexfloat << previous_fluid_volume
-        << ' ' << departed_after_row << '\n';
+        << '\n';
     statistics.save_values(out);
     out.close();
     AssertThrow(out, dealii::ExcMessage("Cannot write " + directory));
@@ -330,10 +330,9 @@ namespace ImmersedGrains
     const auto removed = optional_line("grains_removed", 1);
     // Absent before fluid_volume_balance: its first row after the resume
     // is then 0.
-    const auto books = optional_line("fluid_volume_books", 2);
+    const auto books = optional_line("fluid_volume_books", 1);
     previous_fluid_volume =
       books.empty() ? std::numeric_limits<double>::quiet_NaN() : books[0];
-    departed_after_row = books.empty() ? 0 : books[1];
     statistics.load_values(in);
     if (grains)
       grains->set_removed(static_cast<unsigned long>(

@@ -124,9 +124,10 @@ namespace ImmersedGrains
       coupling->project(*grains);
     }
     // The last row's fluid volume as the new mesh holds it: the grains
-    // projected anew, with those that left after that row's projection.
+    // and what is left of the departed ones projected anew, which hold
+    // what that row's projection held.
     previous_fluid_volume = coupling && coupling_parameters.two_way ?
-                              coupling->fluid_volume() - departed_after_row :
+                              coupling->fluid_volume() :
                               std::numeric_limits<double>::quiet_NaN();
     update_shortest_cell_edge();
   }

@@ -257,8 +257,6 @@ namespace ImmersedGrains
                        imbalance / (dt * crossing) :
                        0.0);
       previous_fluid_volume = fluid_volume;
-      departed_after_row =
-        coupling && grains ? coupling->removed_since_projection(*grains) : 0;
     }
     if (!pressure_drop_points.empty())
       statistics.set("pressure_drop",

@@ -98,16 +98,21 @@ namespace ImmersedGrains
     void
     attach(FluidSolver<dim> &fluid) const;
 
+    /** The solid fraction of @p grains and of what is left in the
+     *  mixture of those that departed (Grains::departed()), less what the
+     *  fluid step @p dt takes out of it (project_departed()). Collective. */
     void
-    project(const Grains<dim> &grains);
+    project(Grains<dim> &grains, double dt = 0);
 
     /**
-     * The grains that left through open boundaries since the last fluid
-     * step (Grains::departed()) as the fluid's volume sink over the step
-     * @p dt (SolidFraction::project_sink()): the water that replaces them.
+     * The volume the grains that left through open boundaries
+     * (Grains::departed()) take out of the mixture in the fluid step @p dt,
+     * min(V_left, rate dt) each, as the fluid's volume sink over the step
+     * (SolidFraction::project_sink()): the water that replaces them, at
+     * the rate at which each crosses its own diameter, whatever the step.
      * Their solid flux does not cross the open faces (attach()), so
-     * without it the mixture would lose their volume unreplaced.
-     * Collective.
+     * without it the mixture would lose their volume unreplaced. Call
+     * after project(grains, dt). Collective.
      */
     void
     project_departed(Grains<dim> &grains, double dt);
@@ -202,7 +207,8 @@ namespace ImmersedGrains
     solid_volume() const;
 
     /** The grains' volume that the last project() saw and that has left
-     *  through open boundaries since (@p grains the projected ones):
+     *  through open boundaries since (@p grains the projected ones),
+     *  plus what it held of grains that had left before:
      *  solid_volume() less this is what the grains now are. */
     double
     removed_since_projection(const Grains<dim> &grains) const;
@@ -350,6 +356,8 @@ namespace ImmersedGrains
     double repaid_share = 1;
     // Grains::removed_volume() when project() ran.
     double removed_volume_at_projection = 0;
+    // What the last project() held of departed grains (all ranks).
+    double departed_in_projection = 0;
     // Per active cell: the point drags of its grains.
     std::vector<std::vector<PointDrag<dim>>> cell_drags;
 

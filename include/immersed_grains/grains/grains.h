@@ -205,7 +205,9 @@ namespace ImmersedGrains
   {
     typename dealii::Triangulation<dim>::active_cell_iterator cell;
     dealii::Point<dim> reference; // in cell
-    double             volume;
+    double             volume;    // what is left of it in the mixture
+    double             rate;      // at which it leaves: V |v| / (2 r)
+    double             diameter;
   };
 
   /**
@@ -365,19 +367,24 @@ namespace ImmersedGrains
     removed_volume() const;
 
     /**
-     * The grains that left through open boundaries in the moves since the
-     * last forget_departed() (the coupling takes their volume out of the
-     * mixture: Coupling::project_departed()), each in the locally owned
-     * cell it was last in. After a mesh change they are found again in
-     * the new cells (collective then: a grain may now lie in another
-     * rank's cell, and is listed there).
+     * The grains that left through open boundaries and whose volume has
+     * not yet left the mixture (the coupling takes it out over the time
+     * each takes to cross its own diameter: Coupling::project_departed()),
+     * each in the locally owned cell it was last in. After a mesh change they
+     * are found again in the new cells (collective then: a grain may now lie in
+     * another rank's cell, and is listed there).
      */
     const std::vector<DepartedGrain<dim>> &
     departed();
 
-    /** Empties that list (before the step's moves). */
+    /** Empties that list. */
     void
     forget_departed();
+
+    /** Takes min(volume, rate dt) from each departed grain's volume, and
+     *  drops those that have left whole. */
+    void
+    drain_departed(double dt);
 
     /** That list for a checkpoint: this rank's grains, a line each (the
      *  position where each was last inside, and its volume). */
