@@ -420,7 +420,16 @@ namespace ImmersedGrains
         }
       },
       // The implicit coupling replaces the projected flux.
-      !(parameters.two_way && parameters.implicit_coupling));
+      !(parameters.two_way && parameters.implicit_coupling),
+      parameters.two_way && fraction_rate);
+  }
+
+
+  template <int dim>
+  void
+  Coupling<dim>::set_fraction_rate(const bool needed)
+  {
+    fraction_rate = needed;
   }
 
 

@@ -110,8 +110,11 @@ namespace ImmersedGrains
     const std::function<
       void(const typename dealii::Triangulation<dim>::active_cell_iterator &,
            std::vector<GrainSample<dim>> &)> &samples,
-    const bool                                with_flux)
+    const bool                                with_flux,
+    const bool                                with_rate)
   {
+    flux_for_fluid   = with_flux;
+    flux_for_rate    = with_rate;
     auto volume_rhs  = filter.make_owned_vector();
     auto surface_rhs = parameters.with_mean_diameter ?
                          filter.make_owned_vector() :
@@ -185,7 +188,7 @@ namespace ImmersedGrains
     std::vector<const typename HelmholtzFilter<dim>::Vector *> rhs{&volume_rhs};
     std::vector<typename HelmholtzFilter<dim>::Vector *> fields{&fraction};
     for (unsigned int d = 0; d < dim; ++d)
-      if (with_flux)
+      if (with_flux || with_rate)
       {
         rhs.push_back(&flux_rhs[d]);
         fields.push_back(&flux[d]);
@@ -351,9 +354,12 @@ namespace ImmersedGrains
       evaluate_field(flux[d]);
       for (unsigned int q = 0; q < n_points; ++q)
       {
-        values.solid_flux[q][d] = values.solid_scale[q] * field_values[q];
+        values.solid_flux[q][d] =
+          flux_for_fluid ? values.solid_scale[q] * field_values[q] : 0.0;
         values.grain_velocity[q][d] =
-          solid[q] > 1e-12 ? field_values[q] / solid[q] : 0.0;
+          flux_for_fluid && solid[q] > 1e-12 ? field_values[q] / solid[q] : 0.0;
+        if (flux_for_rate)
+          values.solid_flux_divergence[q] += shapes.gradient_of(local, q)[d];
       }
     }
   }

@@ -159,9 +159,12 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  AdvectionTerm<dim>::AdvectionTerm(const double density, const bool newton)
+  AdvectionTerm<dim>::AdvectionTerm(const double density,
+                                    const bool   newton,
+                                    const bool   skew_symmetric)
       : density(density)
       , newton(newton)
+      , skew_symmetric(skew_symmetric)
   {
   }
 
@@ -180,6 +183,18 @@ namespace ImmersedGrains
     if (newton)
       m.convection_derivative = s.grad_u;
     m.force += s.phi * density * (s.grad_u * s.u);
+    if (skew_symmetric)
+    {
+      // rho u R / 2 with R = d(phi)/dt + div(phi u), d(phi)/dt =
+      // div(s) - mass_source from the grains' filtered flux s: tested with
+      // u it cancels -rho |u|^2 R / 2, the energy the convective form
+      // makes where the fluid's mass balance does not hold pointwise.
+      const double residual = s.phi * dealii::trace(s.grad_u) +
+                              s.grad_phi * s.u + s.solid_flux_divergence -
+                              s.mass_source;
+      m.reaction += 0.5 * density * residual;
+      m.force += 0.5 * density * residual * s.u;
+    }
   }
 
 
@@ -360,9 +375,11 @@ namespace ImmersedGrains
     const MixtureFields<dim>    &mixture_fields,
     dealii::Function<dim>       &open_pressure,
     const double                 time,
-    const bool                   solid_crosses_boundaries)
+    const bool                   solid_crosses_boundaries,
+    const double                 backflow_weight)
       : geometry(geometry)
       , solid_crosses_boundaries(solid_crosses_boundaries)
+      , backflow_weight(backflow_weight)
       , mixture_fields(mixture_fields)
       , open_pressure(open_pressure)
       , time(time)
@@ -428,12 +445,43 @@ namespace ImmersedGrains
           type == BoundaryType::open ?
             open_pressure.value(fe_face_values.quadrature_point(q)) :
             0.0;
-        for (unsigned int a = 0; a < dofs.velocity.size(); ++a)
+        const unsigned int n_s = dofs.velocity.size();
+        for (unsigned int a = 0; a < n_s; ++a)
         {
           const double N = fe_face_values.shape_value(dofs.velocity[a][0], q);
           for (unsigned int c = 0; c < dim; ++c)
             integrals.rhs_u[a * dim + c] -=
               (mixture.fluid_fraction[q] * p_open * (N * n[c])) * JxW;
+        }
+        if (backflow_weight > 0 && type == BoundaryType::open)
+        {
+          // Where the fluid enters: -b rho phi (u.n)/2 N_a N_b on the
+          // velocity block, (u.n) of the current iterate (Picard).
+          const auto            &local = *context.local_solution;
+          dealii::Tensor<1, dim> u;
+          for (unsigned int a = 0; a < n_s; ++a)
+          {
+            const double N = fe_face_values.shape_value(dofs.velocity[a][0], q);
+            for (unsigned int c = 0; c < dim; ++c)
+              u[c] += local[dofs.velocity[a][c]] * N;
+          }
+          const double un = u * n;
+          if (un < 0)
+          {
+            const double weight =
+              -0.5 * backflow_weight * mixture.fluid_fraction[q] * un * JxW;
+            for (unsigned int a = 0; a < n_s; ++a)
+            {
+              const double Na =
+                fe_face_values.shape_value(dofs.velocity[a][0], q);
+              for (unsigned int b = 0; b < n_s; ++b)
+                integrals.K[a * n_s + b] +=
+                  weight * Na *
+                  fe_face_values.shape_value(dofs.velocity[b][0], q);
+              for (unsigned int c = 0; c < dim; ++c)
+                integrals.rhs_u[a * dim + c] -= weight * u[c] * Na;
+            }
+          }
         }
         if (outflux != 0)
           for (unsigned int b = 0; b < dofs.pressure.size(); ++b)

@@ -399,15 +399,16 @@ namespace ImmersedGrains
         for (unsigned int d = 0; d < dim; ++d)
           state.grad_p[d] += value * shapes.Gp[d][b];
       }
-      state.phi            = mixture.fluid_fraction[q];
-      state.grad_phi       = mixture.fluid_fraction_gradient[q];
-      state.beta           = mixture.drag_coefficient[q];
-      state.grain_velocity = mixture.grain_velocity[q];
-      state.beta_last      = mixture.last_velocity_drag[q];
-      state.solid_flux     = mixture.solid_flux[q];
-      state.mass_source    = mixture.mass_source[q];
-      state.alpha          = mixture.pressure_gradient_weight[q];
-      state.mobility       = mixture.pressure_mobility[q];
+      state.phi                   = mixture.fluid_fraction[q];
+      state.grad_phi              = mixture.fluid_fraction_gradient[q];
+      state.beta                  = mixture.drag_coefficient[q];
+      state.grain_velocity        = mixture.grain_velocity[q];
+      state.beta_last             = mixture.last_velocity_drag[q];
+      state.solid_flux            = mixture.solid_flux[q];
+      state.mass_source           = mixture.mass_source[q];
+      state.solid_flux_divergence = mixture.solid_flux_divergence[q];
+      state.alpha                 = mixture.pressure_gradient_weight[q];
+      state.mobility              = mixture.pressure_mobility[q];
       if (forcing)
         for (unsigned int d = 0; d < dim; ++d)
           state.forcing[d] = (*forcing)(d);
@@ -924,7 +925,9 @@ namespace ImmersedGrains
     add(std::make_unique<DragFieldTerm<dim>>(), true);
     add(std::make_unique<PressureContinuityTerm<dim>>(), true);
     if (parameters.advection)
-      add(std::make_unique<AdvectionTerm<dim>>(rho, parameters.newton), true);
+      add(std::make_unique<AdvectionTerm<dim>>(
+            rho, parameters.newton, parameters.skew_symmetric_advection),
+          true);
     if (!forcing_is_zero)
     {
       add(std::make_unique<ForcingTerm<dim>>(), true);
@@ -944,7 +947,9 @@ namespace ImmersedGrains
             *mixture_fields,
             *parameters.open_boundary_pressure,
             time,
-            solid_crosses_boundaries),
+            solid_crosses_boundaries,
+            parameters.advection ? parameters.backflow_stabilization * rho :
+                                   0.0),
           false);
     return list;
   }

@@ -12,6 +12,7 @@ namespace ImmersedGrains
     grain_velocity.resize(n);
     solid_flux.resize(n);
     mass_source.resize(n);
+    solid_flux_divergence.assign(n, 0.0);
     pressure_gradient_weight.assign(n, 0.0);
     pressure_mobility.assign(n, 0.0);
     solid_scale.assign(n, 1.0);

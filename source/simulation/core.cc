@@ -576,6 +576,8 @@ namespace ImmersedGrains
                                         fluid_parameters.advection,
                                         *timer);
       coupling->setup();
+      coupling->set_fraction_rate(fluid_parameters.advection &&
+                                  fluid_parameters.skew_symmetric_advection);
       coupling->attach(*fluid);
       coupling->project(*grains);
       if (!coupled_step)

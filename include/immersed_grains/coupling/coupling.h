@@ -104,6 +104,13 @@ namespace ImmersedGrains
     void
     project(Grains<dim> &grains, double dt = 0);
 
+    /** Whether the fluid needs the fluid fraction's rate of change (the
+     *  skew-symmetric advection, Fluid/Advection form): project() then
+     *  projects the grains' flux for its divergence also where the
+     *  implicit coupling supplies the flux itself. */
+    void
+    set_fraction_rate(bool needed);
+
     /**
      * The volume the grains that left through open boundaries
      * (Grains::departed()) take out of the mixture in the fluid step @p dt,
@@ -234,6 +241,7 @@ namespace ImmersedGrains
     // own disturbance builds up (SelfDisturbance).
     const bool           fluid_transient;
     const bool           fluid_advection;
+    bool                 fraction_rate = false;
     dealii::TimerOutput &timer;
 
     std::shared_ptr<SolidFraction<dim>> projection;

@@ -82,13 +82,17 @@ namespace ImmersedGrains
     /**
      * Fills the fields from @p samples, which lists the grains of each
      * locally owned cell; the flux only if @p with_flux (else zero: the
-     * implicit coupling supplies its own).
+     * implicit coupling supplies its own). With @p with_rate the flux is
+     * projected all the same, for its divergence only: the fluid
+     * fraction's rate of change that the skew-symmetric advection needs
+     * (MixtureValues::solid_flux_divergence).
      */
     void
     project(const std::function<void(
               const typename dealii::Triangulation<dim>::active_cell_iterator &,
               std::vector<GrainSample<dim>> &)> &samples,
-            bool                                 with_flux = true);
+            bool                                 with_flux = true,
+            bool                                 with_rate = false);
 
     /**
      * The mixture's volume sink of grains that left through open
@@ -216,6 +220,9 @@ namespace ImmersedGrains
     // (0: no sink).
     typename HelmholtzFilter<dim>::Vector sink;
     double                                sink_rate = 0;
+    // What the last project() made of the flux fields: the grains' flux
+    // for the fluid, and/or its divergence only.
+    bool         flux_for_fluid = true, flux_for_rate = false;
     double       smallest_diameter = 0, largest_diameter = 0;
     unsigned int clamped = 0;
   };

@@ -69,9 +69,10 @@ namespace ImmersedGrains
     dealii::Tensor<1, dim> grain_velocity;
     double                 beta_last = 0; // its share against u_last
     dealii::Tensor<1, dim> solid_flux;    // (1 - phi) u_p, explicit part
-    double                 mass_source = 0;
-    double                 alpha       = 0; // pressure-gradient weight
-    double                 mobility    = 0; // pressure mobility k
+    double                 mass_source           = 0;
+    double                 solid_flux_divergence = 0; // -d(phi_s)/dt
+    double                 alpha    = 0; // pressure-gradient weight
+    double                 mobility = 0; // pressure mobility k
     dealii::Tensor<1, dim> forcing;
   };
 
@@ -232,7 +233,7 @@ namespace ImmersedGrains
   class AdvectionTerm : public AssemblyTerm<dim>
   {
   public:
-    AdvectionTerm(double density, bool newton);
+    AdvectionTerm(double density, bool newton, bool skew_symmetric);
     void
     point(const PointState<dim> &,
           const ScalarShapes<dim> &,
@@ -247,6 +248,8 @@ namespace ImmersedGrains
   private:
     const double density;
     const bool   newton;
+    // Fluid/Advection form = skew-symmetric.
+    const bool skew_symmetric;
   };
 
 
@@ -335,7 +338,8 @@ namespace ImmersedGrains
                      const MixtureFields<dim>    &mixture_fields,
                      dealii::Function<dim>       &open_pressure,
                      double                       time,
-                     bool                         solid_crosses_boundaries);
+                     bool                         solid_crosses_boundaries,
+                     double                       backflow_weight);
     void
     cell(const CellContext<dim> &, CellIntegrals &) const override;
 
@@ -345,8 +349,10 @@ namespace ImmersedGrains
     needed(const Geometry<dim> &geometry, bool solid_crosses_boundaries);
 
   private:
-    const Geometry<dim>                         &geometry;
-    const bool                                   solid_crosses_boundaries;
+    const Geometry<dim> &geometry;
+    const bool           solid_crosses_boundaries;
+    // b rho of the backflow term on open faces (0: none, as for Stokes).
+    const double                                 backflow_weight;
     const MixtureFields<dim>                    &mixture_fields;
     dealii::Function<dim>                       &open_pressure;
     const double                                 time;

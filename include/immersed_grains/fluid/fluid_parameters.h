@@ -35,13 +35,18 @@ namespace ImmersedGrains
                      const std::string        &file,
                      const Geometry<dim>      &geometry);
 
-    bool         enabled         = true;
-    double       density         = 1.0;
-    double       viscosity       = 1.0;
-    bool         advection       = true;
-    bool         time_derivative = true;
-    unsigned int bdf_order       = 2;
-    bool         newton          = false;
+    bool   enabled   = true;
+    double density   = 1.0;
+    double viscosity = 1.0;
+    bool   advection = true;
+    // Advection form: phi rho (u.grad)u plus rho u R / 2, R the fluid's
+    // pointwise mass residual (doc/theory.md).
+    bool skew_symmetric_advection = false;
+    // b of the open faces' inflow term -b rho phi min(u.n, 0) u.v / 2.
+    double       backflow_stabilization = 1;
+    bool         time_derivative        = true;
+    unsigned int bdf_order              = 2;
+    bool         newton                 = false;
     // One solve per step with the extrapolated advecting velocity.
     bool extrapolated_advection = true;
     // How the continuum drag is integrated (the entry "Drag coefficient

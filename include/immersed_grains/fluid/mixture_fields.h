@@ -29,6 +29,10 @@ namespace ImmersedGrains
     std::vector<dealii::Tensor<1, dim>> grain_velocity;
     std::vector<dealii::Tensor<1, dim>> solid_flux; // (1 - phi) u_p
     std::vector<double>                 mass_source;
+    // div of the grains' filtered volume flux at the start of the step:
+    // -d(phi_s)/dt of the projection, the fluid fraction's rate of change
+    // (the skew-symmetric advection form; 0 without grains).
+    std::vector<double> solid_flux_divergence;
     // With the grains' velocity implicit (doc/theory.md 3): the momentum
     // equation gains alpha grad p (the pressure force on grains tied to the
     // fluid by drag), and the solid flux is s + alpha u - k grad p.
