@@ -27,19 +27,26 @@ import matplotlib.pyplot as plt  # noqa: E402
 D, RHO_P, RHO_F, MU, G = 1e-3, 2500.0, 1000.0, 1e-3, 9.81
 
 
-def terminal_velocity():
+def terminal_velocity(d=D):
     """A lone sphere's settling velocity with Dallavalle's drag,
     C_D = (0.63 + 4.8 / sqrt(Re))^2 (bisection on the force balance)."""
     lo, hi = 1e-6, 10.0
     for _ in range(200):
         v = 0.5 * (lo + hi)
-        re = RHO_F * v * D / MU
+        re = RHO_F * v * d / MU
         cd = (0.63 + 4.8 / math.sqrt(re)) ** 2
-        if 0.75 * cd * RHO_F * v * v / D > (RHO_P - RHO_F) * G:
+        if 0.75 * cd * RHO_F * v * v / d > (RHO_P - RHO_F) * G:
             hi = v
         else:
             lo = v
     return v
+
+
+def richardson_zaki_exponent(v_t, d=D):
+    """Garside & Al-Dibouni's n = (5.1 + 0.27 Re_t^0.9) / (1 + 0.1 Re_t^0.9)
+    at a lone grain's settling Reynolds number."""
+    k = 0.1 * (RHO_F * v_t * d / MU) ** 0.9
+    return (5.1 + 2.7 * k) / (1 + k)
 
 
 def ergun_gradient(u, eps):
@@ -108,9 +115,7 @@ def main():
     slope = np.sum(u_up[packed] * dp_up[packed]) / np.sum(u_up[packed] ** 2)
     u_mf = weight / slope
     v_t = terminal_velocity()
-    re_t = RHO_F * v_t * D / MU
-    k = 0.1 * re_t ** 0.9
-    n_rz = (5.1 + 2.7 * k) / (1 + k)
+    n_rz = richardson_zaki_exponent(v_t)
 
     figure, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
     left.plot(u_up * 1e3, dp_up / weight, "o-", ms=4, label="rising U")

@@ -385,7 +385,7 @@ namespace ImmersedGrains
     {
       GrainSample<dim> s{};
       s.reference_location = g.reference;
-      s.volume             = g.volume - std::min(g.volume, g.rate * dt);
+      s.volume             = g.volume - g.drained(dt);
       s.diameter           = g.diameter;
       if (s.volume <= 0)
         continue;
@@ -448,7 +448,7 @@ namespace ImmersedGrains
     {
       GrainSample<dim> s{};
       s.reference_location = g.reference;
-      s.volume             = std::min(g.volume, g.rate * dt);
+      s.volume             = g.drained(dt);
       samples.emplace_back(g.cell, s);
     }
     projection->project_sink(samples, dt);

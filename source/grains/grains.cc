@@ -1407,7 +1407,7 @@ namespace ImmersedGrains
   Grains<dim>::drain_departed(const double dt)
   {
     for (auto &g : departed_grains)
-      g.volume -= std::min(g.volume, g.rate * dt);
+      g.volume -= g.drained(dt);
     departed_grains.erase(std::remove_if(departed_grains.begin(),
                                          departed_grains.end(),
                                          [](const DepartedGrain<dim> &g)

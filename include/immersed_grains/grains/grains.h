@@ -15,6 +15,7 @@
 #include <immersed_grains/grains/placement.h>
 #include <immersed_grains/mesh/geometry.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -208,6 +209,14 @@ namespace ImmersedGrains
     double             volume;    // what is left of it in the mixture
     double             rate;      // at which it leaves: V |v| / (2 r)
     double             diameter;
+
+    /** The volume that leaves the mixture over a step @p dt: the rate's
+     *  share, or what is left of the grain. */
+    double
+    drained(const double dt) const
+    {
+      return std::min(volume, rate * dt);
+    }
   };
 
   /**
