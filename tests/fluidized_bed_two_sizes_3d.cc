@@ -30,8 +30,8 @@
 // Checked: the centroids' separation, mean over 1.5-2.5 s, between 0.85
 // and 1.2 of it. Mixed beads have none; 0.85 leaves room for a mixed zone
 // between the layers (Epstein et al. observe one) a large bead thick;
-// 1.2 for a bed three large beads across that breathes (each centroid's
-// half-second means move by 0.1 mm, its rows by 0.5 mm). Measured: 1.05.
+// 1.2 for a bed three large beads across that breathes (over the window
+// the centroids' rows span 0.16 and 0.40 mm). Measured: 1.05.
 // This checks segregation and its extent, not the drag law's size
 // correction: under Beetstra's law, blind to the size, the bed segregates
 // as far (1.08); the hindered_settling_yin_sundaresan tests check that.
