@@ -41,8 +41,8 @@ NAMES = ("small", "large")
 
 
 def voidage(u, d):
-    """Richardson-Zaki, U / v_t = eps^n, with Garside & Al-Dibouni's
-    n = (5.1 + 0.27 Re_t^0.9) / (1 + 0.1 Re_t^0.9)."""
+    """Richardson-Zaki, U / v_t = eps^n, with Garside & Al-Dibouni's n:
+    (eps, v_t, n) for beads of diameter d."""
     v_t = terminal_velocity(d)
     n = richardson_zaki_exponent(v_t, d)
     return (u / v_t) ** (1 / n), v_t, n
