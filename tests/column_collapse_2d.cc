@@ -1,9 +1,10 @@
 // A granular column collapsing in a viscous liquid, prepared loose and
 // dense (Rondon, Pouliquen & Aussillous 2011), reduced to about 500
 // glass discs (radius 112.5 um +- 20 %, 2500 kg/m^3) in the experiment's
-// liquid (1010 kg/m^3, 0.012 Pa s), Stokes flow. The packings are
-// tests/packings/column_2d_{loose,dense}.txt, made by the .prm files
-// beside them: poured at area fraction 0.5 into a closed box 4.5 mm wide,
+// liquid (1010 kg/m^3, 0.012 Pa s), Stokes flow: the first 0.5 s of the
+// ready scenes prm/column_collapse_2d_{loose,dense}.prm. The packings are
+// prm/packings/column_collapse_2d_{loose,dense}.txt, made by the .prm
+// files beside them: poured at area fraction 0.5 into a closed box 4.5 mm wide,
 // the discs settle through the liquid with friction 1 (they lock where
 // they land: bulk packing 0.750, about 6 mm tall) or without friction
 // (they slide into a dense packing: 0.819, 5.5 mm). Each is released at
@@ -56,7 +57,7 @@ using namespace dealii;
 namespace
 {
   const std::string packings =
-    std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/packings/";
+    std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/../prm/packings/";
 
   void
   collapse(const std::string &name)
@@ -86,7 +87,7 @@ subsection Grains
   subsection Placement
     set Shape = file
     set File  = )" +
-                   packings + "column_2d_" + name + R"(.txt
+                   packings + "column_collapse_2d_" + name + R"(.txt
   end
 end
 subsection Contacts
