@@ -433,6 +433,18 @@ end
      "set Dimension = 2\nsubsection Output\n set Boundary forces = 7\nend\n",
      "Boundary forces",
      "boundary id 7"},
+    {"boundary_contact_force_open_id",
+     "set Dimension = 2\nsubsection Mesh\n set Boundary conditions = wall, "
+     "wall, wall, open\nend\nsubsection Output\n set Boundary contact "
+     "forces = 2, 3\nend\n" +
+       dry_grain,
+     "Boundary contact forces",
+     "grains do not meet it"},
+    {"boundary_contact_force_without_grains",
+     "set Dimension = 2\nsubsection Output\n set Boundary contact forces = "
+     "2\nend\n",
+     "Boundary contact forces",
+     "needs grains with contacts"},
     {"boundary_flux_unknown_id",
      "set Dimension = 2\nsubsection Output\n set Boundary fluxes = 0, "
      "5\nend\n",

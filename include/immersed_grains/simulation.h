@@ -288,6 +288,8 @@ namespace ImmersedGrains
      * columns. */
     std::vector<dealii::types::boundary_id> boundary_force_ids;
     std::string                             boundary_force_text;
+    std::vector<dealii::types::boundary_id> boundary_contact_force_ids;
+    std::string                             boundary_contact_force_text;
     std::vector<dealii::types::boundary_id> boundary_flux_ids;
     // The last row's fluid_volume, for fluid_volume_balance: after a mesh
     // change, the same grains' (and departed grains') on the new mesh (NaN

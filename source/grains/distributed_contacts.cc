@@ -64,7 +64,7 @@ namespace ImmersedGrains
              periodic_axes(geometry))
       , solver(parameters)
   {
-    geometry.add_walls(walls);
+    wall_boundary_ids = geometry.add_walls(walls);
   }
 
 
@@ -599,6 +599,26 @@ namespace ImmersedGrains
       p = std::max(p, q);
     return dealii::Utilities::MPI::max(time_step > 0 ? p / time_step : 0.,
                                        comm);
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::add_boundary_impulses(
+    std::map<dealii::types::boundary_id, dealii::Tensor<1, dim>> &impulses)
+    const
+  {
+    // The wall is the contact's partner: the normal impulse pushes it
+    // along the normal, from the grain towards the wall.
+    const auto &on_walls = solver.wall_impulses();
+    for (unsigned int m = 0;
+         m < wall_contacts.size() && m < on_walls.normal.size();
+         ++m)
+    {
+      auto &sum = impulses[wall_boundary_ids[wall_contacts[m].wall]];
+      sum +=
+        on_walls.normal[m] * wall_contacts[m].normal + on_walls.tangential[m];
+    }
   }
 
 

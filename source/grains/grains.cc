@@ -806,6 +806,16 @@ namespace ImmersedGrains
       free_velocity = c.velocity;
     report.contacts = contacts->solve(
       arrays.position, c, dt, report.alert_distance, arrays.cell);
+    if (record_boundary_impulses)
+    {
+      if (!add_to_step_impulse)
+      {
+        step_boundary_impulse.clear();
+        step_boundary_time = 0;
+      }
+      contacts->add_boundary_impulses(step_boundary_impulse);
+      step_boundary_time += dt;
+    }
     for (unsigned int i = 0; i < free_velocity.size(); ++i)
       arrays.contact_impulse[i] =
         (add_to_step_impulse ? arrays.contact_impulse[i] :
@@ -1252,6 +1262,39 @@ namespace ImmersedGrains
   Grains<dim>::contact_forces() const
   {
     return contacts ? contacts->contact_forces() : std::vector<ContactForce>();
+  }
+
+
+  template <int dim>
+  void
+  Grains<dim>::record_boundary_contact_forces()
+  {
+    record_boundary_impulses = true;
+  }
+
+
+  template <int dim>
+  std::vector<dealii::Tensor<1, dim>>
+  Grains<dim>::boundary_contact_forces(
+    const std::vector<dealii::types::boundary_id> &ids) const
+  {
+    Assert(record_boundary_impulses, dealii::ExcInternalError());
+    // Each contact is solved on one rank: the ranks' sums add up.
+    std::vector<double> sums(ids.size() * dim, 0.);
+    for (unsigned int k = 0; k < ids.size(); ++k)
+    {
+      const auto found = step_boundary_impulse.find(ids[k]);
+      if (found != step_boundary_impulse.end())
+        for (unsigned int d = 0; d < dim; ++d)
+          sums[k * dim + d] = found->second[d];
+    }
+    dealii::Utilities::MPI::sum(sums, comm, sums);
+    std::vector<dealii::Tensor<1, dim>> forces(ids.size());
+    if (step_boundary_time > 0)
+      for (unsigned int k = 0; k < ids.size(); ++k)
+        for (unsigned int d = 0; d < dim; ++d)
+          forces[k][d] = sums[k * dim + d] / step_boundary_time;
+    return forces;
   }
 
 

@@ -874,18 +874,25 @@ namespace ImmersedGrains
 
 
   template <int dim>
-  void
+  std::vector<dealii::types::boundary_id>
   Geometry<dim>::add_walls(Contact::Walls<dim> &walls) const
   {
     const auto meets = [](const BoundaryType t)
     { return t != BoundaryType::open && t != BoundaryType::periodic; };
+    const unsigned int                      first = walls.n_walls();
+    std::vector<dealii::types::boundary_id> ids;
     if (box)
     {
       std::array<bool, 2 * dim> is_wall;
       for (unsigned int f = 0; f < 2 * dim; ++f)
         is_wall[f] = meets(boundary_types.at(f));
-      walls.add_box(lower_corner, upper_corner, is_wall);
-      return;
+      const auto numbers = walls.add_box(lower_corner, upper_corner, is_wall);
+      // A box's boundary ids are its face numbers.
+      ids.resize(walls.n_walls() - first);
+      for (unsigned int f = 0; f < 2 * dim; ++f)
+        if (is_wall[f])
+          ids[numbers[f] - first] = f;
+      return ids;
     }
     // Points numbered by position (to a billionth of the domain), so that
     // facets of neighbouring faces share the numbers of their corners.
@@ -982,10 +989,12 @@ namespace ImmersedGrains
             if (normal * (cell->center() - points[piece[0]]) < 0)
               normal = -normal;
             facets.push_back({piece, normal});
+            ids.push_back(face->boundary_id());
           }
         }
     if (!facets.empty())
       walls.add_facets(points, facets);
+    return ids;
   }
 
 

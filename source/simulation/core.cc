@@ -166,6 +166,17 @@ namespace ImmersedGrains
         "discrete momentum equation, which converges with the flow's "
         "order; others the traction integrated over the faces.");
       prm.declare_entry(
+        "Boundary contact forces",
+        "",
+        Anything(),
+        "Boundary ids (comma list) whose force from the grains' contacts is "
+        "recorded: columns boundary_contact_force_<id>_x, _y[, _z] [N; N/m "
+        "in 2D], the impulse the contacts of a fluid step (all its grain "
+        "sub-steps) gave those faces, normal and tangential, divided by the "
+        "step. A bed at rest on a floor weighs on it with its weight less "
+        "what the liquid and the side walls carry. Ids of wall, slip or "
+        "inflow boundaries (those the grains meet), with contacts on.");
+      prm.declare_entry(
         "Boundary fluxes",
         "",
         Anything(),
@@ -311,6 +322,28 @@ namespace ImmersedGrains
           name,
           *text,
           "boundary id " + std::to_string(id) + " is not on the mesh");
+    for (const auto id : boundary_contact_force_ids)
+    {
+      const auto type = geometry.boundary_types.find(id);
+      InputLocation{file, "Output"}.require(
+        type != geometry.boundary_types.end(),
+        "Boundary contact forces",
+        boundary_contact_force_text,
+        "boundary id " + std::to_string(id) + " is not on the mesh");
+      InputLocation{file, "Output"}.require(
+        type->second != BoundaryType::open &&
+          type->second != BoundaryType::periodic,
+        "Boundary contact forces",
+        boundary_contact_force_text,
+        "boundary id " + std::to_string(id) +
+          " is open or periodic: grains do not meet it");
+    }
+    InputLocation{file, "Output"}.require(
+      boundary_contact_force_ids.empty() ||
+        (grain_parameters.enabled && grain_parameters.contacts_enabled),
+      "Boundary contact forces",
+      boundary_contact_force_text,
+      "needs grains with contacts (Grains/Enabled, Contacts/Enabled)");
     for (const auto &[name, point] : probes)
       InputLocation{file, "Output"}.require(geometry.contains(point),
                                             "Probes",
@@ -551,6 +584,8 @@ namespace ImmersedGrains
         grains->deserialize();
       else
         grains->initialize(grain_seeds);
+      if (!boundary_contact_force_ids.empty())
+        grains->record_boundary_contact_forces();
       const auto &c = grain_parameters.contact;
       pcout << "  grains: " << grains->particle_handler().n_global_particles()
             << ", " << grains->layout().n_properties << " properties per grain";

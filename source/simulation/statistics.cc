@@ -131,6 +131,12 @@ namespace ImmersedGrains
     for (const auto id : boundary_force_ids)
       for (unsigned int d = 0; d < dim; ++d)
         columns.push_back("boundary_force_" + std::to_string(id) + axes[d]);
+    boundary_contact_force_ids =
+      parse_ids("Boundary contact forces", boundary_contact_force_text);
+    for (const auto id : boundary_contact_force_ids)
+      for (unsigned int d = 0; d < dim; ++d)
+        columns.push_back("boundary_contact_force_" + std::to_string(id) +
+                          axes[d]);
     boundary_flux_ids = parse_ids("Boundary fluxes", boundary_flux_text);
     for (const auto id : boundary_flux_ids)
       columns.push_back("boundary_flux_" + std::to_string(id));
@@ -291,6 +297,18 @@ namespace ImmersedGrains
     *grain_statistics = grains->compute_statistics();
     const auto &s     = *grain_statistics;
     s.set_statistics(statistics, !fluid);
+    if (!boundary_contact_force_ids.empty())
+    {
+      static const char *const axes[] = {"_x", "_y", "_z"};
+      const auto               on_boundaries =
+        grains->boundary_contact_forces(boundary_contact_force_ids);
+      for (unsigned int k = 0; k < boundary_contact_force_ids.size(); ++k)
+        for (unsigned int d = 0; d < dim; ++d)
+          statistics.set("boundary_contact_force_" +
+                           std::to_string(boundary_contact_force_ids[k]) +
+                           axes[d],
+                         on_boundaries[k][d]);
+    }
     if (coupling && s.solid_volume > 0)
     {
       // Conservation of the projection: what the fluid sees against what

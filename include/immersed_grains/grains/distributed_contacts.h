@@ -125,6 +125,16 @@ namespace ImmersedGrains
     std::vector<ContactForce>
     contact_forces() const;
 
+    /**
+     * Adds the impulse that the last step's contacts solved on this rank
+     * gave each boundary (the walls of Geometry::add_walls()) to
+     * @p impulses, by boundary id: what the grains pushed that boundary
+     * with, normal and tangential parts.
+     */
+    void
+    add_boundary_impulses(std::map<dealii::types::boundary_id,
+                                   dealii::Tensor<1, dim>> &impulses) const;
+
   private:
     MPI_Comm             comm;
     const unsigned int   my_rank;
@@ -132,9 +142,11 @@ namespace ImmersedGrains
     const bool           friction;
     const Geometry<dim> &geometry;
 
-    Contact::BucketGrid<dim>    grid;
-    Contact::Walls<dim>         walls;
-    Contact::ContactSolver<dim> solver;
+    Contact::BucketGrid<dim> grid;
+    Contact::Walls<dim>      walls;
+    // The boundary id of each wall, by wall number.
+    std::vector<dealii::types::boundary_id> wall_boundary_ids;
+    Contact::ContactSolver<dim>             solver;
 
     std::vector<std::vector<dealii::BoundingBox<dim>>> rank_boxes;
     PartitionHalo                                      halo;

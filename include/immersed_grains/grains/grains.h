@@ -16,6 +16,7 @@
 #include <immersed_grains/mesh/geometry.h>
 
 #include <algorithm>
+#include <map>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -361,6 +362,19 @@ namespace ImmersedGrains
     std::vector<ContactForce>
     contact_forces() const;
 
+    /** From now on, each step sums the impulse its contacts (all its
+     *  sub-steps) give each boundary, for boundary_contact_forces(). */
+    void
+    record_boundary_contact_forces();
+
+    /** The force the grains' contacts exerted on each boundary of @p ids
+     *  over the last step: the impulse summed over its sub-steps divided
+     *  by its length (zero where the grains met that boundary nowhere;
+     *  collective). */
+    std::vector<dealii::Tensor<1, dim>>
+    boundary_contact_forces(
+      const std::vector<dealii::types::boundary_id> &ids) const;
+
     /** The grains that left through open boundaries since the start. */
     unsigned long
     n_removed() const;
@@ -455,6 +469,12 @@ namespace ImmersedGrains
     // their reference field and no cell: departed() finds their cells.
     bool              departed_need_cells = false;
     StraightPathDrift drift;
+    // The step's impulse on each boundary, and the time it was summed over
+    // (record_boundary_contact_forces()).
+    bool record_boundary_impulses = false;
+    std::map<dealii::types::boundary_id, dealii::Tensor<1, dim>>
+           step_boundary_impulse;
+    double step_boundary_time = 0;
 
     /** The other ranks' cells near each owned cell (update_partition()). */
     typename DistributedContacts<dim>::PartitionHalo

@@ -184,8 +184,9 @@ namespace ImmersedGrains
 
     /** Adds the boundaries grains meet (wall, slip and velocity ids) to
      *  @p walls: the box's planes, or the boundary faces of a Gmsh mesh as
-     *  facets (a quadrilateral face as two triangles in 3D). */
-    void
+     *  facets (a quadrilateral face as two triangles in 3D). Returns the
+     *  boundary id of each wall added, in the order of their numbers. */
+    std::vector<dealii::types::boundary_id>
     add_walls(Contact::Walls<dim> &walls) const;
 
     /** The bounding box of the domain. */
