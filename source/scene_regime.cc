@@ -446,6 +446,15 @@ namespace ImmersedGrains
           " under Drag law = " + coupling_parameters.drag_law +
           ": the polydisperse correction is fitted on mixtures of diameter "
           "ratio up to 4 (doc/theory.md)");
+      if (coupling_parameters.drag_law == "van der Hoef-Beetstra" &&
+          placed_fraction > 0 && placed_fraction < 0.1)
+        regime.warnings.push_back(
+          "grains of several sizes placed at solid fraction " +
+          number(placed_fraction, 2) +
+          " under Drag law = van der Hoef-Beetstra: its correction was "
+          "fitted at solid fractions 0.1-0.6 and keeps the factor d/<d> in "
+          "the dilute limit, where a grain should have its Stokes drag "
+          "(doc/theory.md); use Drag law = Yin-Sundaresan");
     }
     if (coupled && h < d && l < d)
       regime.warnings.push_back(

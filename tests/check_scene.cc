@@ -18,7 +18,9 @@
 // filter smooths the ball's collective flow) and 160 discs in a box (a
 // suspension: the filtered drag with a filter half the box wide, none).
 // Grains of two sizes (radii 1:2) under the default law (a warning: a law
-// for one size), under Yin-Sundaresan (none), and radii 1:5 under it (a
+// for one size), under Yin-Sundaresan (none), under van der
+// Hoef-Beetstra (a warning: this dilute box lies below the solid fractions
+// its correction was fitted at), and radii 1:5 under Yin-Sundaresan (a
 // warning: fitted to diameter ratio 4).
 //
 // The report's figures in e-notation with a negative exponent (a grain's
@@ -160,6 +162,13 @@ main()
         two_sizes + "  set Class radii = 12.5e-6, 25e-6\n");
   check("two_sizes_yin_sundaresan",
         stokes_filtered + "  set Drag law = Yin-Sundaresan\n",
+        true,
+        200,
+        3,
+        false,
+        two_sizes + "  set Class radii = 12.5e-6, 25e-6\n");
+  check("two_sizes_van_der_hoef",
+        stokes_filtered + "  set Drag law = van der Hoef-Beetstra\n",
         true,
         200,
         3,
