@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -146,6 +147,41 @@ column_index(const std::vector<std::vector<std::string>> &rows,
   const auto at = std::find(rows[0].begin(), rows[0].end(), name);
   AssertThrow(at != rows[0].end(), dealii::ExcMessage("no column " + name));
   return at - rows[0].begin();
+}
+
+// The mean of @p value(row) over the statistics rows after time @p from,
+// each weighted by its step (`dt`): a time average that the adaptive
+// step does not bias towards the moments of short steps.
+inline double
+time_average(
+  const std::vector<std::vector<std::string>>                   &rows,
+  const double                                                   from,
+  const std::function<double(const std::vector<std::string> &)> &value)
+{
+  const unsigned int t  = column_index(rows, "time"),
+                     dt = column_index(rows, "dt");
+  double integral = 0, duration = 0;
+  for (unsigned int r = 1; r < rows.size(); ++r)
+    if (std::stod(rows[r][t]) > from)
+    {
+      const double step = std::stod(rows[r][dt]);
+      integral += value(rows[r]) * step;
+      duration += step;
+    }
+  return integral / duration;
+}
+
+// The same for the column @p name.
+inline double
+time_average(const std::vector<std::vector<std::string>> &rows,
+             const double                                 from,
+             const std::string                           &name)
+{
+  const unsigned int c = column_index(rows, name);
+  return time_average(rows,
+                      from,
+                      [c](const std::vector<std::string> &row)
+                      { return std::stod(row[c]); });
 }
 
 #endif

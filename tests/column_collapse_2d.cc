@@ -119,24 +119,18 @@ end
   {
     const auto         rows = read_csv_rows(name + "/statistics.csv");
     const unsigned int t    = column_index(rows, "time"),
-                       dt   = column_index(rows, "dt"),
                        p    = column_index(rows, "probe_base_pressure"),
                        x    = column_index(rows, "grains_max_x");
     const double L0         = std::stod(rows[1][x]);
     Collapse     c{0, (std::stod(rows.back()[x]) - L0) / L0, 0, 0};
-    double       duration = 0;
     for (unsigned int r = 1; r < rows.size(); ++r)
     {
       if (std::abs(std::stod(rows[r][t]) - 0.1) < 1e-9)
         c.early_run_out = (std::stod(rows[r][x]) - L0) / L0;
       c.lowest_excess = std::min(c.lowest_excess, std::stod(rows[r][p]));
-      if (std::stod(rows[r][t]) > 0.2 + 1e-9)
-      {
-        c.mean_excess += std::stod(rows[r][p]) * std::stod(rows[r][dt]);
-        duration += std::stod(rows[r][dt]);
-      }
     }
-    c.mean_excess /= duration * weight;
+    c.mean_excess =
+      time_average(rows, 0.2 + 1e-9, "probe_base_pressure") / weight;
     c.lowest_excess /= weight;
     return c;
   }

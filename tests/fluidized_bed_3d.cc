@@ -120,18 +120,8 @@ main(int argc, char **argv)
 
   {
     const auto         rows = read_csv_rows("fluidized/statistics.csv");
-    const unsigned int t    = column_index(rows, "time"),
-                       dt   = column_index(rows, "dt"),
-                       dp   = column_index(rows, "pressure_drop"),
-                       in   = column_index(rows, "boundary_flux_4");
-    double integral = 0, duration = 0;
-    for (unsigned int r = 1; r < rows.size(); ++r)
-      if (std::stod(rows[r][t]) > 0.4)
-      {
-        integral += std::stod(rows[r][dp]) * std::stod(rows[r][dt]);
-        duration += std::stod(rows[r][dt]);
-      }
-    const double ratio = integral / duration / weight;
+    const unsigned int in   = column_index(rows, "boundary_flux_4");
+    const double ratio      = time_average(rows, 0.4, "pressure_drop") / weight;
     std::cout << "fluidized: mean pressure drop / buoyant weight per area "
               << "in [0.98, 1.02]: "
               << (std::abs(ratio - 1) < 0.02 ? "yes" : "no") << '\n'

@@ -122,28 +122,18 @@ end
     return 0;
 
   const auto         rows  = read_csv_rows("bed/statistics.csv");
-  const unsigned int t     = column_index(rows, "time"),
-                     dt    = column_index(rows, "dt"),
-                     dp    = column_index(rows, "pressure_drop"),
-                     floor = column_index(rows, "boundary_contact_force_4_z"),
-                     small = column_index(rows, "class0_centroid_z"),
+  const unsigned int small = column_index(rows, "class0_centroid_z"),
                      large = column_index(rows, "class1_centroid_z"),
                      n0    = column_index(rows, "class0_particles"),
                      n1    = column_index(rows, "class1_particles");
-  double duration = 0, pressure = 0, on_floor = 0, separation = 0;
-  for (unsigned int r = 1; r < rows.size(); ++r)
-    if (std::stod(rows[r][t]) > 1.5)
-    {
-      const double step = std::stod(rows[r][dt]);
-      duration += step;
-      pressure += std::stod(rows[r][dp]) * step;
-      on_floor -= std::stod(rows[r][floor]) * step;
-      separation +=
-        (std::stod(rows[r][small]) - std::stod(rows[r][large])) * step;
-    }
-  pressure /= duration;
-  on_floor /= duration;
-  separation /= duration;
+  const double pressure    = time_average(rows, 1.5, "pressure_drop");
+  const double on_floor =
+    -time_average(rows, 1.5, "boundary_contact_force_4_z");
+  const double separation =
+    time_average(rows,
+                 1.5,
+                 [&](const std::vector<std::string> &row)
+                 { return std::stod(row[small]) - std::stod(row[large]); });
 
   const double area   = 0.006 * 0.006;
   const double volume = std::stod(rows.back()[n0]) * (M_PI / 6 * 1e-9) +
