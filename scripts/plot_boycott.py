@@ -5,12 +5,17 @@ the suspension's top against time, and the Ponder-Nakamura-Kuroda
 prediction for the leaning tank from the vertical tank's settling
 velocity. Prints the table of doc/scenes/boycott_2d.md.
 
-    /usr/bin/python3 scripts/plot_boycott.py output/boycott_2d_0 output/boycott_2d_30 [--angle 30] [--out boycott.png]
+    /usr/bin/python3 scripts/plot_boycott.py output/boycott_2d_0 output/boycott_2d_30 [--angle 30] [--radius 25e-6] [--out boycott.png]
 
 The suspension's top at a written state is the highest height at which
 the discs' area fraction, over horizontal strips of 0.25 mm, is at least
 half the initial one (the tank's horizontal width is the same at every
-height, so the strips of both tanks compare).
+height, so the strips of both tanks compare). The clear fluid is the area
+of the squares, cut along the walls' lean and each holding about twelve
+discs at the initial fraction, that hold less than half of it: the
+fluid the theory counts, wherever it lies (under the top or under the
+leaning wall); H minus its area over W is the level the top would have
+if all of it had risen to the top.
 """
 import argparse
 import math
@@ -28,7 +33,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from plot_scene import particle_states  # noqa: E402
 
 # The scene's tank and suspension (prm/meshes/boycott_2d.py defaults).
-WIDTH, HEIGHT, RADIUS, STRIP = 1.5e-3, 6e-3, 25e-6, 0.25e-3
+WIDTH, HEIGHT, STRIP = 1.5e-3, 6e-3, 0.25e-3
+RADIUS = 25e-6  # --radius
 
 
 def states(directory):
@@ -46,17 +52,36 @@ def top(points, fraction0):
     return (dense[-1] + 1) * STRIP if len(dense) else 0.0
 
 
+def clear_level(points, fraction0, lean):
+    """H minus the clear fluid's area over W (see the module's text)."""
+    side = math.sqrt(12 * math.pi * RADIUS ** 2 / fraction0)
+    nx = max(1, int(round(WIDTH / side)))
+    ny = max(1, int(round(HEIGHT / (WIDTH / nx))))
+    counts = np.histogram2d(points[:, 0] - points[:, 1] * lean, points[:, 1],
+                            bins=(nx, ny), range=((0, WIDTH), (0, HEIGHT)))[0]
+    square = WIDTH / nx * HEIGHT / ny
+    clear = (counts * math.pi * RADIUS ** 2 / square < 0.5 * fraction0).sum()
+    return HEIGHT - clear * square / WIDTH
+
+
 def main():
+    global RADIUS
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("vertical")
     parser.add_argument("leaning")
     parser.add_argument("--angle", type=float, default=30)
+    parser.add_argument("--radius", type=float, default=RADIUS,
+                        help="the discs' radius [m] (prm/meshes/boycott_2d.py)")
     parser.add_argument("--out")
     args = parser.parse_args()
+    RADIUS = args.radius
     runs = [states(args.vertical), states(args.leaning)]
     fraction0 = len(runs[0][0][1]) * math.pi * RADIUS ** 2 / (WIDTH * HEIGHT)
     curves = [(np.array([t for t, _ in run]),
                np.array([top(p, fraction0) for _, p in run])) for run in runs]
+    tan = math.tan(math.radians(args.angle))
+    clear = [np.array([clear_level(p, fraction0, lean) for _, p in run])
+             for run, lean in zip(runs, (0.0, tan))]
 
     # The vertical tank's settling velocity v0: the slope of its top while
     # it is above half the tank (least squares).
@@ -66,7 +91,6 @@ def main():
     # Ponder-Nakamura-Kuroda: clear fluid forms at v0 under the top and
     # under the downward-facing wall, dh/dt = -v0 (1 + h tan(angle)/W);
     # exactly h(t) = (H + W/tan) exp(-v0 tan t/W) - W/tan.
-    tan = math.tan(math.radians(args.angle))
     t1, h1 = curves[1]
     grid = np.linspace(0, t1[-1], 200)
     pnk = (HEIGHT + WIDTH / tan) * np.exp(-v0 * tan * grid / WIDTH) \
@@ -85,6 +109,7 @@ def main():
     t_pnk = WIDTH / (v0 * tan) * math.log((HEIGHT + WIDTH / tan) /
                                           (half + WIDTH / tan))
     t_half = crossing(t1, h1)
+    t_clear = [crossing(t, c) for (t, _), c in zip(curves, clear)]
 
     figure = plt.figure(figsize=(10, 4.5))
     grid_spec = figure.add_gridspec(1, 4, width_ratios=[0.8, 1.4, 0.001, 2.2])
@@ -109,6 +134,8 @@ def main():
     plot.plot(t0, (HEIGHT - v0 * t0) * 1e3, "k:", lw=1,
               label="v0 = %.1f µm/s" % (v0 * 1e6))
     plot.plot(t1, h1 * 1e3, "s", ms=3, label="walls at %g°" % args.angle)
+    plot.plot(t1, clear[1] * 1e3, "x", ms=3, color="tab:orange",
+              label="walls at %g°: clear fluid's level" % args.angle)
     plot.plot(grid, pnk * 1e3, "k-", lw=1,
               label="Ponder–Nakamura–Kuroda")
     plot.set_ylim(0, HEIGHT * 1.05e3)
@@ -131,6 +158,15 @@ def main():
           % (rate / v0, 1 + HEIGHT * tan / WIDTH))
     print("| time for the top to reach half the tank [s] | %.1f | %.1f | %.1f |"
           % (0.5 * HEIGHT / v0, t_half, t_pnk))
+    print("| time for the clear fluid to fill half the tank [s] | %.1f | %.1f "
+          "| %.1f |" % (t_clear[0], t_clear[1], t_pnk))
+    def theory(t):
+        return (HEIGHT + WIDTH / tan) * math.exp(-v0 * tan * t / WIDTH) \
+            - WIDTH / tan
+    print("clear fluid of the leaning tank over the theory's at",
+          ", ".join("%g s: %.2f" % (t, (HEIGHT - np.interp(t, t1, clear[1]))
+                                    / (HEIGHT - theory(t)))
+                    for t in (1, 2, 3, 5, 7)))
     print("figure:", out)
 
 
