@@ -5,7 +5,7 @@ the suspension's top against time, and the Ponder-Nakamura-Kuroda
 prediction for the leaning tank from the vertical tank's settling
 velocity. Prints the table of doc/scenes/boycott_2d.md.
 
-    /usr/bin/python3 scripts/plot_boycott.py output/boycott_2d_0 output/boycott_2d_30 [--angle 30] [--radius 25e-6] [--out boycott.png]
+    /usr/bin/python3 scripts/plot_boycott.py output/boycott_2d_0 output/boycott_2d_30 [--angle 30] [--radius 25e-6] [--width 1.5e-3] [--out boycott.png]
 
 The suspension's top at a written state is the highest height at which
 the discs' area fraction, over horizontal strips of 0.25 mm, is at least
@@ -33,8 +33,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from plot_scene import particle_states  # noqa: E402
 
 # The scene's tank and suspension (prm/meshes/boycott_2d.py defaults).
-WIDTH, HEIGHT, STRIP = 1.5e-3, 6e-3, 0.25e-3
-RADIUS = 25e-6  # --radius
+HEIGHT, STRIP = 6e-3, 0.25e-3
+WIDTH, RADIUS = 1.5e-3, 25e-6  # --width, --radius
 
 
 def states(directory):
@@ -65,16 +65,18 @@ def clear_level(points, fraction0, lean):
 
 
 def main():
-    global RADIUS
+    global RADIUS, WIDTH
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("vertical")
     parser.add_argument("leaning")
     parser.add_argument("--angle", type=float, default=30)
     parser.add_argument("--radius", type=float, default=RADIUS,
                         help="the discs' radius [m] (prm/meshes/boycott_2d.py)")
+    parser.add_argument("--width", type=float, default=WIDTH,
+                        help="the tank's horizontal width [m]")
     parser.add_argument("--out")
     args = parser.parse_args()
-    RADIUS = args.radius
+    RADIUS, WIDTH = args.radius, args.width
     runs = [states(args.vertical), states(args.leaning)]
     fraction0 = len(runs[0][0][1]) * math.pi * RADIUS ** 2 / (WIDTH * HEIGHT)
     curves = [(np.array([t for t, _ in run]),
