@@ -21,10 +21,12 @@
 // Navier-Stokes drop reads lower than the Stokes one (with the 2 mm
 // filter 0.963 against 0.992, the floor's contacts carrying 0 and 0.010),
 // by about the momentum the liquid loses from the distributor (U/phi) to
-// the top (U), rho U^2 (1/phi - 1) per area: 0.021 of the weight at the
-// floor's fluid fraction 0.74 (seven probes), 0.047 at 0.555 with 2 mm.
-// The ready scene's wider column does not show that difference
-// (doc/validation.md, "Several sizes"). Measured: 0.980 (two ranks 0.981).
+// the top (U): measured over the floor and the top faces
+// (scripts/column_balance.py), 0.017 of the weight, and the face drop
+// 0.984, the floor's contacts 0.005: the balance closes to 0.6 % (0.047
+// at the floor's fluid fraction 0.555 with 2 mm). The ready scene's wider
+// column leaves 1.4-3.6 % unaccounted (doc/validation.md, "Several
+// sizes"). Measured: 0.980 (two ranks 0.981).
 // The floor. The lowest large beads touch the distributor now and then:
 // its contact force (Output/Boundary contact forces), mean over the
 // window, carries 0.46 % of the buoyant weight (two ranks 0.32 %);
