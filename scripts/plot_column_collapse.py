@@ -21,13 +21,22 @@ The run-out is (L - L0)/L0, L the largest x a grain's centre reaches
 stands against the wall at x = 0. The excess pore pressure is the probe
 `base` (statistics column probe_base_pressure, the pressure minus the
 hydrostatic part) in units of the column's buoyant weight per area
-W = (rho_p - rho) g (sum of the discs' areas) / L0.
+W = (rho_p - rho) g (sum of the discs' areas) / L0; for a 3D slab,
+periodic across its thickness T, W = (rho_p - rho) g (sum of the beads'
+volumes) / (L0 T), T read from the box of the run's parameter file
+(or --thickness). The 3D slabs (doc/scenes/column_collapse_2d.md, "A 3D
+slab of beads"):
+
+    build/immersed-grains prm/column_collapse_3d_slab_loose.prm
+    build/immersed-grains prm/column_collapse_3d_slab_dense.prm
+    /usr/bin/python3 scripts/plot_column_collapse.py output/column_collapse_3d_slab_loose output/column_collapse_3d_slab_dense --out column_collapse_3d_slab.png
 """
 import argparse
 import csv
 import glob
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -59,25 +68,49 @@ def statistics(directory):
         if not rows or column not in rows[0]:
             sys.exit("plot_column_collapse.py: no column %s in %s"
                      % (column, path))
-    return {k: np.array([float(r[k]) for r in rows]) for k in
-            ("time", "dt", "grains_max_x", "grains_max_y",
-             "probe_base_pressure")}
+    s = {k: np.array([float(r[k]) for r in rows]) for k in
+         ("time", "dt", "grains_max_x", "grains_max_y",
+          "probe_base_pressure")}
+    s["dim"] = 3 if "grains_max_z" in rows[0] else 2
+    return s
 
 
-def disc_area(directory):
-    """The discs' total area, from the radii of the first written state."""
+def grain_measure(directory, dim):
+    """The discs' total area (2D) or the beads' total volume (3D), from the
+    radii of the first written state."""
     first = sorted(glob.glob(os.path.join(directory, "particles_00000*.vtu")))
     if not first:
         sys.exit("plot_column_collapse.py: no particles_00000*.vtu in "
                  + directory)
-    return sum(float(np.sum(math.pi * read_vtu(f)[1]["radius"] ** 2))
-               for f in first)
+    radii = np.concatenate([read_vtu(f)[1]["radius"] for f in first])
+    if dim == 2:
+        return float(np.sum(math.pi * radii ** 2))
+    return float(np.sum(4.0 / 3.0 * math.pi * radii ** 3))
 
 
-def measure(directory):
+def box_thickness(directory):
+    """The z extent of the box in the run's copy of its parameter file."""
+    corners = {}
+    for path in glob.glob(os.path.join(directory, "*.prm")):
+        with open(path) as f:
+            for line in f:
+                m = re.match(r"\s*set\s+(Lower|Upper) corner\s*=\s*(.*)", line)
+                if m:
+                    corners[m.group(1)] = [float(v) for v in
+                                           m.group(2).split("#")[0].split(",")]
+    if len(corners) < 2 or len(corners["Upper"]) < 3:
+        sys.exit("plot_column_collapse.py: no 3D box corners in a .prm in %s;"
+                 " give --thickness" % directory)
+    return corners["Upper"][2] - corners["Lower"][2]
+
+
+def measure(directory, thickness=None):
     s = statistics(directory)
     L0, H0 = s["grains_max_x"][0], s["grains_max_y"][0]
-    W = (RHO_P - RHO) * G * disc_area(directory) / L0
+    per_area = L0
+    if s["dim"] == 3:
+        per_area *= thickness if thickness else box_thickness(directory)
+    W = (RHO_P - RHO) * G * grain_measure(directory, s["dim"]) / per_area
     run_out = (s["grains_max_x"] - L0) / L0
     excess = s["probe_base_pressure"] / W
     final = run_out[-1]
@@ -103,8 +136,12 @@ def main():
     parser.add_argument("loose")
     parser.add_argument("dense")
     parser.add_argument("--out", default="column_collapse_2d.png")
+    parser.add_argument("--thickness", type=float,
+                        help="a 3D slab's thickness [m] (default: the z "
+                        "extent of the box in the run's parameter file)")
     args = parser.parse_args()
-    runs = {"loose": measure(args.loose), "dense": measure(args.dense)}
+    runs = {"loose": measure(args.loose, args.thickness),
+            "dense": measure(args.dense, args.thickness)}
     colours = {"loose": "tab:orange", "dense": "tab:blue"}
 
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5))
