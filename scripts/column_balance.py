@@ -33,31 +33,11 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from plot_scene import read_vtu  # noqa: E402
+from plot_scene import read_vtu, run_parameters  # noqa: E402
 
 
 def fail(message):
     sys.exit("column_balance.py: " + message)
-
-
-def parameters(directory):
-    """Each 'set' of the run's parameter file copy, by its path."""
-    files = glob.glob(os.path.join(directory, "*.prm"))
-    if not files:
-        fail("no copy of the parameter file (*.prm) in " + directory)
-    values, path = {}, []
-    with open(files[0]) as f:
-        for line in f:
-            line = line.split("#")[0].strip()
-            if line.startswith("subsection "):
-                path.append(line[len("subsection "):].strip())
-            elif line == "end" and path:
-                path.pop()
-            else:
-                m = re.match(r"set\s+(.*?)\s*=\s*(.*)", line)
-                if m:
-                    values["/".join(path + [m.group(1)])] = m.group(2)
-    return values
 
 
 def states(directory, start):
@@ -94,7 +74,7 @@ def main():
                         "along the last axis)")
     args = parser.parse_args()
 
-    prm = parameters(args.directory)
+    prm = run_parameters(args.directory, "column_balance.py")
     dim = int(prm.get("Dimension", "2"))
     axis = dim - 1
     rho = float(prm.get("Fluid/Density", "1000"))

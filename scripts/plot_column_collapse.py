@@ -36,7 +36,6 @@ import csv
 import glob
 import math
 import os
-import re
 import sys
 
 import numpy as np
@@ -46,7 +45,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from plot_scene import particle_states, read_vtu  # noqa: E402
+from plot_scene import particle_states, read_vtu, run_parameters  # noqa: E402
 
 # The discs and liquid of Rondon et al. (2011), as in column_collapse_2d.
 RHO_P, RHO, G = 2500.0, 1010.0, 9.81
@@ -90,18 +89,14 @@ def grain_measure(directory, dim):
 
 def box_thickness(directory):
     """The z extent of the box in the run's copy of its parameter file."""
-    corners = {}
-    for path in glob.glob(os.path.join(directory, "*.prm")):
-        with open(path) as f:
-            for line in f:
-                m = re.match(r"\s*set\s+(Lower|Upper) corner\s*=\s*(.*)", line)
-                if m:
-                    corners[m.group(1)] = [float(v) for v in
-                                           m.group(2).split("#")[0].split(",")]
-    if len(corners) < 2 or len(corners["Upper"]) < 3:
-        sys.exit("plot_column_collapse.py: no 3D box corners in a .prm in %s;"
-                 " give --thickness" % directory)
-    return corners["Upper"][2] - corners["Lower"][2]
+    prm = run_parameters(directory, "plot_column_collapse.py")
+    try:
+        lower, upper = ([float(v) for v in prm["Mesh/%s corner" % k].split(",")]
+                        for k in ("Lower", "Upper"))
+        return upper[2] - lower[2]
+    except (KeyError, IndexError, ValueError):
+        sys.exit("plot_column_collapse.py: no 3D box corners in the "
+                 "parameter file in %s; give --thickness" % directory)
 
 
 def measure(directory, thickness=None):

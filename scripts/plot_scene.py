@@ -108,6 +108,29 @@ def particle_states(directory, caller, names=()):
     return out
 
 
+def run_parameters(directory, caller):
+    """Each 'set' of the run's copy of its parameter file in @p directory,
+    by its path ("Mesh/Upper corner"); @p caller names the script in the
+    message when there is none."""
+    files = glob.glob(os.path.join(directory, "*.prm"))
+    if not files:
+        sys.exit("%s: no copy of the parameter file (*.prm) in %s"
+                 % (caller, directory))
+    values, path = {}, []
+    with open(files[0]) as f:
+        for line in f:
+            line = line.split("#")[0].strip()
+            if line.startswith("subsection "):
+                path.append(line[len("subsection "):].strip())
+            elif line == "end" and path:
+                path.pop()
+            else:
+                m = re.match(r"set\s+(.*?)\s*=\s*(.*)", line)
+                if m:
+                    values["/".join(path + [m.group(1)])] = m.group(2)
+    return values
+
+
 def pieces(directory, prefix, step):
     files = sorted(glob.glob(os.path.join(directory, prefix + "_*.vtu")))
     steps = sorted({int(re.search(prefix + r"_(\d+)\.", f).group(1))
