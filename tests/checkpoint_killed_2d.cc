@@ -18,7 +18,9 @@
 //
 // Wall time interval: a run of 4 steps with Every steps = 0 and an
 // interval of a microsecond saves after every step (and keeps the two
-// newest sets, steps 3 and 4); with an interval of 1e6 s it saves none.
+// newest sets, steps 3 and 4); with an interval of 60 s it saves none (the
+// interval counts from the run's start, not from the clock's epoch, which
+// made every run save at its first step).
 #include <sys/wait.h>
 
 #include "checkpoint_test_support.h"
@@ -173,10 +175,10 @@ main()
                             "  set Every steps = 0\n"
                             "  set Wall time interval = 1e-6\n"))
             << ", checkpoints" << checkpoint_sets("interval") << '\n';
-  std::cout << "Wall time interval = 1e6 s, 4 steps: "
+  std::cout << "Wall time interval = 60 s, 4 steps: "
             << describe(run("no_interval",
                             0.2,
                             "  set Every steps = 0\n"
-                            "  set Wall time interval = 1e6\n"))
+                            "  set Wall time interval = 60\n"))
             << ", checkpoints" << checkpoint_sets("no_interval") << '\n';
 }

@@ -1,6 +1,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <immersed_grains/io/checkpoint.h>
+#include <immersed_grains/io/progress_line.h>
 #include <immersed_grains/parameters.h>
 
 #include <algorithm>
@@ -40,7 +41,8 @@ namespace ImmersedGrains
                         "0",
                         Double(0),
                         "Also save it when this many wall-clock seconds "
-                        "have passed since the last save (0: never).");
+                        "have passed since the last save, or since the run "
+                        "started (0: never).");
       prm.declare_entry(
         "Resume",
         "auto",
@@ -77,6 +79,9 @@ namespace ImmersedGrains
       : parameters(parameters)
       , directory(output_directory + "/checkpoints")
       , comm(comm)
+      // The interval counts from the run's start: a run (or a resumed
+      // one) does not save at its first step.
+      , last_wall(wall_clock())
   {
   }
 
