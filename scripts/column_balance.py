@@ -25,15 +25,13 @@ densities and gravity are read from the run's copy of its parameter file.
 """
 import argparse
 import csv
-import glob
 import os
-import re
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from plot_scene import read_vtu, run_parameters  # noqa: E402
+from plot_scene import pvd_states, read_vtu, run_parameters  # noqa: E402
 
 
 def fail(message):
@@ -43,21 +41,15 @@ def fail(message):
 def states(directory, start):
     """(time, points, pressure, velocity, fluid fraction) of each field
     state written from @p start on."""
-    try:
-        with open(os.path.join(directory, "fields.pvd")) as f:
-            entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"',
-                                 f.read())
-    except OSError:
+    entries = pvd_states(directory, "fields.pvd")
+    if not entries:
         fail("no fields.pvd in %s (set Output/Write fields every)"
              % directory)
-    for time, name in entries:
-        if float(time) < start - 1e-12:
+    for time, files in entries:
+        if time < start - 1e-12:
             continue
-        base = os.path.join(directory, name)
-        files = [base] if name.endswith(".vtu") else sorted(
-            glob.glob(base.replace(".pvtu", ".*.vtu")))
         pieces = [read_vtu(f) for f in files]
-        yield (float(time),
+        yield (time,
                np.concatenate([p[0] for p in pieces]),
                *(np.concatenate([p[1][k] for p in pieces])
                  for k in ("pressure", "velocity", "fluid_fraction")))

@@ -75,34 +75,44 @@ def read_vtu(path):
     return points, arrays, cell_names
 
 
+def pvd_states(directory, series):
+    """(time, the .vtu files of its pieces) of every state the list
+    @p series (e.g. "particles.pvd") in a run's output directory holds;
+    empty when there is none."""
+    try:
+        with open(os.path.join(directory, series)) as f:
+            entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"',
+                                 f.read())
+    except OSError:
+        return []
+    out = []
+    for time, name in entries:
+        base = os.path.join(directory, name)
+        out.append((float(time), [base] if name.endswith(".vtu") else sorted(
+            glob.glob(base.replace(".pvtu", ".*.vtu")))))
+    return out
+
+
 def particle_states(directory, caller, names=()):
     """(time, grain centres) of every state particles.pvd lists in a run's
     output directory, whatever the number of pieces; with @p names, (time,
     centres, {name: values}) with those particle fields (e.g. "radius").
     @p caller names the script in the message when there is none."""
-    try:
-        with open(os.path.join(directory, "particles.pvd")) as f:
-            entries = re.findall(r'timestep="([^"]+)".*?file="([^"]+)"',
-                                 f.read())
-    except OSError:
-        entries = []
+    entries = pvd_states(directory, "particles.pvd")
     if not entries:
         sys.exit(caller + ": no particles.pvd in " + directory)
     out = []
-    for time, name in entries:
-        base = os.path.join(directory, name)
-        files = [base] if name.endswith(".vtu") else sorted(
-            glob.glob(base.replace(".pvtu", ".*.vtu")))
+    for time, files in entries:
         pieces_read = [read_vtu(f) for f in files]
         centres = np.concatenate([p[0] for p in pieces_read])
         if not names:
-            out.append((float(time), centres))
+            out.append((time, centres))
             continue
         missing = [n for n in names if n not in pieces_read[0][1]]
         if missing:
             sys.exit("%s: no particle field %s in %s" %
                      (caller, ", ".join(missing), files[0]))
-        out.append((float(time), centres,
+        out.append((time, centres,
                     {n: np.concatenate([p[1][n] for p in pieces_read])
                      for n in names}))
     return out
