@@ -24,8 +24,12 @@ hydrostatic part) in units of the column's buoyant weight per area
 W = (rho_p - rho) g (sum of the discs' areas) / L0; for a 3D slab,
 periodic across its thickness T, W = (rho_p - rho) g (sum of the beads'
 volumes) / (L0 T), T read from the box of the run's parameter file
-(or --thickness). The 3D slabs (doc/scenes/column_collapse_2d.md, "A 3D
-slab of beads"):
+(or --thickness). A collapse repeats only to within a spread: two runs
+that part at round-off end at run-outs up to 15 % apart. `--repeat LOOSE
+DENSE` (as often as wanted) adds runs of the same two scenes made to part
+(e.g. with a time step 1-4 % off): their run-outs are drawn as thin lines,
+and a second table gives each measure's mean and range over all the pairs.
+The 3D slabs (doc/scenes/column_collapse_2d.md, "A 3D slab of beads"):
 
     build/immersed-grains prm/column_collapse_3d_slab_loose.prm
     build/immersed-grains prm/column_collapse_3d_slab_dense.prm
@@ -134,9 +138,16 @@ def main():
     parser.add_argument("--thickness", type=float,
                         help="a 3D slab's thickness [m] (default: the z "
                         "extent of the box in the run's parameter file)")
+    parser.add_argument("--repeat", nargs=2, action="append", default=[],
+                        metavar=("LOOSE", "DENSE"),
+                        help="another run of each scene, made to part from "
+                        "the first (repeatable)")
     args = parser.parse_args()
     runs = {"loose": measure(args.loose, args.thickness),
             "dense": measure(args.dense, args.thickness)}
+    repeats = [{"loose": measure(loose, args.thickness),
+                "dense": measure(dense, args.thickness)}
+               for loose, dense in args.repeat]
     colours = {"loose": "tab:orange", "dense": "tab:blue"}
 
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5))
@@ -146,6 +157,10 @@ def main():
     for (name, r), ax_dep in zip(runs.items(), axes[1]):
         t = r["s"]["time"]
         ax_run.plot(t, r["run_out"], color=colours[name], label=name)
+        for k, pair in enumerate(repeats):
+            ax_run.plot(pair[name]["s"]["time"], pair[name]["run_out"],
+                        color=colours[name], lw=0.6, alpha=0.6,
+                        label=name + ", repeated" if k == 0 else None)
         ax_p.plot(t, r["excess"], color=colours[name], lw=0.8, label=name)
         for k, (time, points) in enumerate((r["states"][0],
                                             r["states"][-1])):
@@ -189,6 +204,29 @@ def main():
                                      f(runs["dense"])))
     print("dense/loose final run-out: %.2f"
           % (runs["dense"]["final"] / runs["loose"]["final"]))
+    if repeats:
+        pairs = [runs] + repeats
+        print()
+        print("Over the %d pairs, mean (lowest - highest):" % len(pairs))
+        print("| | loose | dense |")
+        print("|---|---|---|")
+
+        def spread(values, form):
+            return "%s (%s - %s)" % (form % np.mean(values),
+                                     form % min(values), form % max(values))
+
+        for label, key, form in (
+                ("final run-out (L - L0)/L0", "final", "%.2f"),
+                ("time to 90 % of it [s]", "t90", "%.2f"),
+                ("final height / H0", "height", "%.2f"),
+                ("mean excess pore pressure from %.1f s to t90 / W"
+                 % TRANSIENT, "mean_excess", "%+.3f")):
+            print("| %s | %s | %s |" % (
+                label, spread([p["loose"][key] for p in pairs], form),
+                spread([p["dense"][key] for p in pairs], form)))
+        print("dense/loose final run-out: %s" % spread(
+            [p["dense"]["final"] / p["loose"]["final"] for p in pairs],
+            "%.2f"))
     print("wrote " + args.out)
 
 
