@@ -21,7 +21,9 @@
 // for one size), under Yin-Sundaresan (none), under van der
 // Hoef-Beetstra (a warning: this dilute box lies below the solid fractions
 // its correction was fitted at), and radii 1:5 under Yin-Sundaresan (a
-// warning: fitted to diameter ratio 4).
+// warning: fitted to diameter ratio 4). Packed beads read from a file, in
+// the periodic box with the default coupling (a simple cubic stack of
+// touching beads: the filtered drag over 8 radii, none).
 //
 // The report's figures in e-notation with a negative exponent (a grain's
 // radius, terminal velocity, Reynolds number, ...; the stream writes
@@ -50,11 +52,12 @@ void
 check(const std::string &name,
       const std::string &coupling,
       const bool         stokes,
-      const unsigned int count  = 200,
-      const unsigned int dim    = 3,
-      const bool         box_2d = false,
-      const std::string &grains = "",
-      const bool         walled = false)
+      const unsigned int count     = 200,
+      const unsigned int dim       = 3,
+      const bool         box_2d    = false,
+      const std::string &grains    = "",
+      const bool         walled    = false,
+      const std::string &placement = "")
 {
   fs::remove_all("out_" + name);
   {
@@ -88,8 +91,9 @@ check(const std::string &name,
          "  set Radius = 12.5e-6\n"
          "  set Density = 2400\n"
       << grains << "  subsection Placement\n"
-      << (dim == 3 ? std::string("    set Shape = box\n"
-                                 "    set Center = 4e-4, 4e-4, 4e-4\n") +
+      << (!placement.empty() ? placement :
+          dim == 3           ? std::string("    set Shape = box\n"
+                                           "    set Center = 4e-4, 4e-4, 4e-4\n") +
                        (walled ? "    set Size = 6e-4\n" :
                                  "    set Size = 8e-4, 8e-4, 6e-4\n") :
                      std::string(box_2d ? "    set Shape = box\n"
@@ -98,9 +102,10 @@ check(const std::string &name,
                                           "    set Shape = ball\n"
                                           "    set Center = 4e-4, 4e-4\n"
                                           "    set Size = 3e-4\n"))
-      << "    set Count = " << count
-      << "\n"
-         "  end\n"
+      << (placement.empty() ?
+            "    set Count = " + std::to_string(count) + "\n" :
+            "")
+      << "  end\n"
          "end\n"
          "subsection Gravity\n"
          "  set Vector = "
@@ -181,4 +186,24 @@ main()
         3,
         false,
         two_sizes + "  set Class radii = 12.5e-6, 62.5e-6\n");
+  {
+    // 8 x 8 x 4 beads, each touching its neighbours along the axes.
+    std::ofstream f("packed_3d.txt");
+    f.precision(17);
+    for (unsigned int k = 0; k < 4; ++k)
+      for (unsigned int j = 0; j < 8; ++j)
+        for (unsigned int i = 0; i < 8; ++i)
+          f << 3e-4 + 25e-6 * i << ' ' << 3e-4 + 25e-6 * j << ' '
+            << 12.5e-6 + 25e-6 * k << " 12.5e-6\n";
+  }
+  check("packed_3d",
+        "",
+        false,
+        0,
+        3,
+        false,
+        "",
+        false,
+        "    set Shape = file\n"
+        "    set File = packed_3d.txt\n");
 }
