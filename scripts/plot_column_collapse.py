@@ -24,8 +24,8 @@ hydrostatic part) in units of the column's buoyant weight per area
 W = (rho_p - rho) g (sum of the discs' areas) / L0; for a 3D slab,
 periodic across its thickness T, W = (rho_p - rho) g (sum of the beads'
 volumes) / (L0 T), T read from the box of the run's parameter file
-(or --thickness). A collapse repeats only to within a spread: two runs
-that part at round-off end at run-outs up to 15 % apart. `--repeat LOOSE
+(or --thickness). A collapse repeats only to within a spread: runs with
+the time step 1-4 % off end at run-outs up to a fifth apart. `--repeat LOOSE
 DENSE` (as often as wanted) adds runs of the same two scenes made to part
 (e.g. with a time step 1-4 % off): their run-outs are drawn as thin lines,
 and a second table gives each measure's mean and range over all the pairs.
