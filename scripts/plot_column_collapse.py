@@ -26,8 +26,7 @@ periodic across its thickness T, W = (rho_p - rho) g (sum of the beads'
 volumes) / (L0 T), T read from the box of the run's parameter file
 (or --thickness). A collapse repeats only to within a spread: runs with
 the time step 1-4 % off end at run-outs up to a fifth apart. `--repeat LOOSE
-DENSE` (as often as wanted) adds runs of the same two scenes made to part
-(e.g. with a time step 1-4 % off): their run-outs are drawn as thin lines,
+DENSE` (as often as wanted) adds such runs of the two scenes: their run-outs are drawn as thin lines,
 and a second table gives each measure's mean and range over all the pairs.
 The 3D slabs (doc/scenes/column_collapse_2d.md, "A 3D slab of beads"):
 

@@ -499,12 +499,7 @@ namespace ImmersedGrains
   Simulation<dim>::choose_drag_distribution(const std::string &file)
   {
     auto &c = coupling_parameters;
-    // In 3D the count is only needed for a placement that may be a packing:
-    // a suspension of a million grains is spared the search.
-    const auto shape = grain_parameters.shape;
-    if (dim == 2 ||
-        (shape != PlacementShape::ball && shape != PlacementShape::lattice &&
-         !placed_as_suspension(grain_parameters, geometry)))
+    if (dim == 2)
       touching_neighbours = mean_touching_neighbours(grain_seeds);
     if (c.drag_distribution != "auto")
       return;
@@ -530,7 +525,8 @@ namespace ImmersedGrains
     // mean radii lets a block slide off along one band of cells under a
     // suction of several times its weight, on 8 or 10 radii of the largest
     // bead it creeps alike (doc/scenes/column_collapse_2d.md).
-    const auto set = entries_set_in(file);
+    const auto shape = grain_parameters.shape;
+    const auto set   = entries_set_in(file);
     const bool given_length =
       c.projection.smoothing_length > 0 &&
       std::find(set.begin(), set.end(), "Coupling/Smoothing length") !=
@@ -549,9 +545,12 @@ namespace ImmersedGrains
                      "periodic box";
       if (!c.two_way || placed_grains == 0)
         return;
-      const bool packed = !suspension && shape != PlacementShape::ball &&
-                          shape != PlacementShape::lattice &&
-                          touching_neighbours >= packed_neighbours;
+      // Counted only where the placement may be a packing: a suspension of
+      // a million grains is spared the search.
+      if (!suspension && shape != PlacementShape::ball &&
+          shape != PlacementShape::lattice)
+        touching_neighbours = mean_touching_neighbours(grain_seeds);
+      const bool packed = touching_neighbours >= packed_neighbours;
       if (!suspension && !packed)
         return;
       const std::string what =

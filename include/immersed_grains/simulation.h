@@ -315,9 +315,9 @@ namespace ImmersedGrains
     double                                  largest_grain_radius = 0;
     double                                  mean_grain_radius    = 0;
     unsigned int                            placed_grains        = 0;
-    // How many placed grains each touches on average (in 3D only for
-    // placements that may be packed): a packing (2 or more) needs a filter
-    // of a few diameters; free discs in 2D a wide one.
+    // How many placed grains each touches on average (in 3D counted only
+    // where Drag distribution = auto asks): a packing (2 or more) needs a
+    // filter of a few diameters; free discs in 2D a wide one.
     double touching_neighbours = 0;
     // Why Drag distribution = auto became what it is; empty if it was set.
     std::string drag_distribution_choice;
