@@ -164,8 +164,9 @@ namespace ImmersedGrains
             (s.max_impulse > 0 ? s.max_change / s.max_impulse : 0.);
           if (s.max_change <= parameters.tolerance * s.max_impulse)
           {
-            if (schedule.confirm())
+            if (schedule.confirm(result.iterations))
             {
+              schedule.record_confirmation();
               correct();
               if (!schedule.settled)
                 continue;

@@ -129,11 +129,10 @@ namespace ImmersedGrains
     const bool start =
       dealii::Utilities::MPI::max(int(!g.start_velocity.empty()), comm) > 0;
     const unsigned int width =
-      2 + 2 * dim + (start ? dim : 0) + 1 + (friction ? 1 + spin_dim : 0) + 1;
+      1 + 2 * dim + (start ? dim : 0) + 1 + (friction ? 1 + spin_dim : 0) + 1;
 
     send_lists.clear();
     recv_lists.clear();
-    multiplicity.assign(n_owned, 1);
     const bool by_cells = cells.size() == n_owned && halo.offsets.size() > 1;
     for (unsigned int i = 0; i < n_owned; ++i)
     {
@@ -153,20 +152,14 @@ namespace ImmersedGrains
           {
             auto &list = send_lists[q];
             if (list.empty() || list.back() != i)
-            {
               list.push_back(i);
-              ++multiplicity[i];
-            }
           }
         }
         continue;
       }
       for (unsigned int q = 0; q < n_ranks; ++q)
         if (q != my_rank && distance_to_rank(all_positions[i], q) < range)
-        {
           send_lists[q].push_back(i);
-          ++multiplicity[i];
-        }
     }
 
     std::map<unsigned int, std::vector<double>> out;
@@ -177,7 +170,6 @@ namespace ImmersedGrains
       for (const unsigned int i : list)
       {
         buffer.push_back(static_cast<double>(ids[i]));
-        buffer.push_back(multiplicity[i]);
         for (unsigned int d = 0; d < dim; ++d)
           buffer.push_back(all_positions[i][d]);
         for (unsigned int d = 0; d < dim; ++d)
@@ -197,19 +189,6 @@ namespace ImmersedGrains
     }
     const auto in = dealii::Utilities::MPI::some_to_some(comm, out);
 
-    // Mass splitting: every copy of a shared grain carries m/k.
-    shared_owned.clear();
-    shared_slot.resize(n_owned);
-    for (unsigned int i = 0; i < n_owned; ++i)
-      if (multiplicity[i] > 1)
-      {
-        g.inverse_mass[i] *= multiplicity[i];
-        if (friction)
-          g.inverse_inertia[i] *= multiplicity[i];
-        shared_slot[i] = shared_owned.size();
-        shared_owned.push_back(i);
-      }
-
     ghost_owner.clear();
     for (const auto &[q, buffer] : in)
     {
@@ -220,10 +199,9 @@ namespace ImmersedGrains
         list.push_back(all_positions.size());
         ghost_owner.push_back(q);
         ids.push_back(static_cast<std::uint64_t>(b[0]));
-        const double           k = b[1];
         dealii::Point<dim>     x;
         dealii::Tensor<1, dim> v, v0;
-        unsigned int           c = 2;
+        unsigned int           c = 1;
         for (unsigned int d = 0; d < dim; ++d)
           x[d] = b[c++];
         for (unsigned int d = 0; d < dim; ++d)
@@ -236,10 +214,10 @@ namespace ImmersedGrains
             v0[d] = b[c++];
           g.start_velocity.push_back(v0);
         }
-        g.inverse_mass.push_back(k * b[c++]);
+        g.inverse_mass.push_back(b[c++]);
         if (friction)
         {
-          g.inverse_inertia.push_back(k * b[c++]);
+          g.inverse_inertia.push_back(b[c++]);
           Contact::AngularVelocity<dim> w;
           for (unsigned int d = 0; d < spin_dim; ++d)
             w[d] = b[c++];
@@ -271,6 +249,91 @@ namespace ImmersedGrains
                                        [&](const Contact::WallContact<dim> &c)
                                        { return c.grain >= n_owned; }),
                         wall_contacts.end());
+  }
+
+
+  template <int dim>
+  void
+  DistributedContacts<dim>::split_masses(Contact::GrainArrays<dim> &g)
+  {
+    std::vector<bool> in_contact(all_positions.size(), false);
+    for (const auto &p : pairs)
+    {
+      in_contact[p.first]  = true;
+      in_contact[p.second] = true;
+    }
+    for (const auto &c : wall_contacts)
+      in_contact[c.grain] = true;
+
+    // Each ghost tells its owner whether it is in one of this rank's
+    // contacts: on two ranks no copy of rank 0's grains is, since rank 0
+    // solves every contact they share with rank 1's.
+    glue_ghosts.clear();
+    std::map<unsigned int, std::vector<unsigned int>> flags_out;
+    for (const auto &[q, list] : recv_lists)
+    {
+      auto &flags = flags_out[q];
+      for (const unsigned int j : list)
+      {
+        flags.push_back(in_contact[j]);
+        if (in_contact[j])
+          glue_ghosts[q].push_back(j);
+      }
+    }
+    const auto flags_in = dealii::Utilities::MPI::some_to_some(comm, flags_out);
+
+    owner_in_contact.assign(in_contact.begin(), in_contact.begin() + n_owned);
+    copies.assign(n_owned, 0);
+    for (unsigned int i = 0; i < n_owned; ++i)
+      copies[i] = owner_in_contact[i];
+    glue_owned.clear();
+    for (const auto &[q, flags] : flags_in)
+    {
+      const auto &list = send_lists.at(q);
+      AssertDimension(list.size(), flags.size());
+      for (unsigned int m = 0; m < list.size(); ++m)
+        if (flags[m])
+        {
+          glue_owned[q].push_back(list[m]);
+          ++copies[list[m]];
+        }
+    }
+
+    // Mass splitting over the copies in contacts: each carries m/k.
+    std::map<unsigned int, std::vector<unsigned int>> split_out;
+    for (const auto &[q, list] : glue_owned)
+      for (const unsigned int i : list)
+        split_out[q].push_back(copies[i]);
+    const auto split_in = dealii::Utilities::MPI::some_to_some(comm, split_out);
+    for (const auto &[q, split] : split_in)
+    {
+      const auto &list = glue_ghosts.at(q);
+      AssertDimension(list.size(), split.size());
+      for (unsigned int m = 0; m < list.size(); ++m)
+      {
+        g.inverse_mass[list[m]] *= split[m];
+        if (friction)
+          g.inverse_inertia[list[m]] *= split[m];
+      }
+    }
+    mass_split.assign(n_owned, 1);
+    shared_owned.clear();
+    shared_slot.resize(n_owned);
+    for (unsigned int i = 0; i < n_owned; ++i)
+    {
+      if (owner_in_contact[i] && copies[i] > 1)
+      {
+        mass_split[i] = copies[i];
+        g.inverse_mass[i] *= copies[i];
+        if (friction)
+          g.inverse_inertia[i] *= copies[i];
+      }
+      if (copies[i] > (owner_in_contact[i] ? 1u : 0u))
+      {
+        shared_slot[i] = shared_owned.size();
+        shared_owned.push_back(i);
+      }
+    }
   }
 
 
@@ -352,15 +415,17 @@ namespace ImmersedGrains
       MPI_Waitall(requests.size(), requests.data(), MPI_STATUSES_IGNORE);
     };
 
-    // 1. Ghost copies go to their owners, which average all copies.
-    // Over the shared grains only: a buffer over all owned grains, zeroed
-    // at every glue, made the glue cost as much as the sweeps between.
-    exchange(recv_lists, send_lists, glue_to_owner_tag, pack);
-    glue_sum.resize(shared_owned.size() * width);
+    // 1. The ghost copies in contacts go to their owners, which average
+    // the copies in contacts. Over the shared grains only: a buffer over
+    // all owned grains, zeroed at every glue, made the glue cost as much as
+    // the sweeps between.
+    exchange(glue_ghosts, glue_owned, glue_to_owner_tag, pack);
+    glue_sum.assign(shared_owned.size() * width, 0.);
     for (unsigned int s = 0; s < shared_owned.size(); ++s)
-      pack(shared_owned[s], glue_sum.data() + s * width);
+      if (owner_in_contact[shared_owned[s]])
+        pack(shared_owned[s], glue_sum.data() + s * width);
     std::size_t offset = 0;
-    for (const auto &[q, list] : send_lists)
+    for (const auto &[q, list] : glue_owned)
       for (const unsigned int i : list)
       {
         for (unsigned int c = 0; c < width; ++c)
@@ -371,17 +436,17 @@ namespace ImmersedGrains
     {
       const unsigned int i = shared_owned[s];
       for (unsigned int c = 0; c < width; ++c)
-        glue_sum[s * width + c] /= multiplicity[i];
+        glue_sum[s * width + c] /= copies[i];
       unpack(i, glue_sum.data() + s * width);
     }
 
-    // 2. The glued velocities go back to every copy.
-    exchange(send_lists,
-             recv_lists,
+    // 2. The glued velocities go back to the copies in contacts.
+    exchange(glue_owned,
+             glue_ghosts,
              glue_from_owner_tag,
              [&](const unsigned int i, double *b) { pack(i, b); });
     offset = 0;
-    for (const auto &[q, list] : recv_lists)
+    for (const auto &[q, list] : glue_ghosts)
       for (const unsigned int i : list)
       {
         unpack(i, recv_buffer.data() + offset);
@@ -409,11 +474,11 @@ namespace ImmersedGrains
     cut(g.sweep_key);
     cut(g.position_correction);
     for (unsigned int i = 0; i < n_owned; ++i)
-      if (multiplicity.size() == n_owned && multiplicity[i] > 1)
+      if (mass_split.size() == n_owned && mass_split[i] > 1)
       {
-        g.inverse_mass[i] /= multiplicity[i];
+        g.inverse_mass[i] /= mass_split[i];
         if (friction)
-          g.inverse_inertia[i] /= multiplicity[i];
+          g.inverse_inertia[i] /= mass_split[i];
       }
   }
 
@@ -433,7 +498,7 @@ namespace ImmersedGrains
     if (ids.empty())
       for (unsigned int i = 0; i < n_owned; ++i)
         ids.push_back(i);
-    multiplicity.assign(n_owned, 1);
+    mass_split.assign(n_owned, 1);
     ghost_owner.clear();
     send_lists.clear();
     recv_lists.clear();
@@ -455,7 +520,10 @@ namespace ImmersedGrains
     grid.find_pairs(all_positions, g.radius, alert, pairs);
     walls.find_contacts(all_positions, g.radius, alert, wall_contacts);
     if (n_ranks > 1)
+    {
       keep_own_contacts();
+      split_masses(g);
+    }
 
     const auto &prm = solver.get_parameters();
     solver.setup(pairs, wall_contacts, walls.velocities(), g, dt);
@@ -549,8 +617,9 @@ namespace ImmersedGrains
         if (s.max_change <= prm.tolerance * s.max_impulse)
         {
           // s is the same on every rank, so all correct together.
-          if (schedule.confirm())
+          if (schedule.confirm(result.iterations))
           {
+            schedule.record_confirmation();
             correct();
             if (!schedule.settled)
               continue;

@@ -119,7 +119,10 @@ namespace ImmersedGrains
      * When the Gauss-Seidel iterations run subspace corrections
      * (ContactSolver::subspace_correction()), in ContactSolver::solve() and
      * in a distributed caller alike: after every interval sweeps, and once
-     * when the sweeps' test is passed before any has run. A step is solved
+     * when the sweeps' test is first passed (after the corrections due by
+     * then, if any: waiting for the next one cost up to interval sweeps of
+     * a step already solved, and on several ranks, where the copies' glue
+     * slows the sweeps, nearly every step hit it). A step is solved
      * when the sweeps' test is passed and the last correction found
      * (almost) nothing left to lower (ContactSolver::settled_by(); such a
      * correction only tests and moves nothing).
@@ -139,26 +142,33 @@ namespace ImmersedGrains
         return interval > 0 && iterations >= last + interval;
       }
 
-      /// Whether the sweeps' test, just passed, calls for a correction
-      /// to confirm it.
+      /// Whether the sweeps' test, just passed after @p iterations sweeps,
+      /// calls for a correction to confirm it: once per step, after a
+      /// sweep since the last correction.
       bool
-      confirm() const
+      confirm(const unsigned int iterations) const
       {
-        return !settled && !corrected;
+        return !settled && !confirmed && iterations > last;
       }
 
       /// Records a correction after @p iterations sweeps.
       void
       record(const unsigned int iterations, const bool settled_now)
       {
-        last      = iterations;
-        corrected = true;
-        settled   = settled_now;
+        last    = iterations;
+        settled = settled_now;
+      }
+
+      /// Records that the next correction confirms a passed test.
+      void
+      record_confirmation()
+      {
+        confirmed = true;
       }
 
       const unsigned int interval;
       unsigned int       last      = 0;
-      bool               corrected = false;
+      bool               confirmed = false;
       bool               settled;
     };
 

@@ -36,11 +36,15 @@ namespace ImmersedGrains
    *    cell (PartitionHalo), else of the box around them;
    *  - each contact is solved by exactly one rank, the lowest rank owning
    *    one of its grains;
-   *  - a grain with copies on k ranks enters every copy's Delassus operator
-   *    with the mass m/k (mass splitting, Visseq et al. 2012); after each
-   *    Gauss-Seidel sweep the copies are glued by averaging their
-   *    velocities, which gives exactly v + sum(impulses)/m: at convergence
-   *    every contact law and the true equation of motion hold, as in serial;
+   *  - a grain whose contacts are solved on k ranks enters each of those
+   *    copies' Delassus operators with the mass m/k (mass splitting,
+   *    Visseq et al. 2012); after every few Gauss-Seidel sweeps these
+   *    copies are glued by averaging their velocities, which gives exactly
+   *    v + sum(impulses)/m: at convergence every contact law and the true
+   *    equation of motion hold, as in serial. A copy in none of its rank's
+   *    contacts takes no share of the mass and no part in the glue (on
+   *    two ranks every copy of rank 0's grains on rank 1), so a grain with
+   *    all its contacts on one rank is solved there as in serial;
    *  - convergence is decided on the maxima over all ranks, so all ranks
    *    sweep the same number of times; ranks exchange after every few
    *    local sweeps (sweeps_per_exchange), not after each;
@@ -160,11 +164,22 @@ namespace ImmersedGrains
     double                                            time_step = 0;
     std::vector<dealii::Point<dim>>                   all_positions;
     std::vector<unsigned int>                         ghost_owner;
-    std::map<unsigned int, std::vector<unsigned int>> send_lists;   // owned
-    std::map<unsigned int, std::vector<unsigned int>> recv_lists;   // ghosts
-    std::vector<unsigned int>                         multiplicity; // owned
-    // The owned grains with copies elsewhere, ascending, and each one's
-    // place among them (valid for those only): a glue touches these alone.
+    std::map<unsigned int, std::vector<unsigned int>> send_lists; // owned
+    std::map<unsigned int, std::vector<unsigned int>> recv_lists; // ghosts
+    // Owned grains: the factor on the inverse mass of this rank's copy
+    // (the number of copies in contacts where this copy is in one, else 1),
+    // and the number of copies the glue averages.
+    std::vector<unsigned int> mass_split, copies;
+    // Per owned grain, whether this rank's copy is in one of its contacts.
+    std::vector<bool> owner_in_contact;
+    // The copies that a glue exchanges: per owner rank, the ghosts here in
+    // one of this rank's contacts (ghost side); per rank, the owned grains
+    // whose copy there is in one of its contacts (owner side), in the same
+    // order.
+    std::map<unsigned int, std::vector<unsigned int>> glue_ghosts, glue_owned;
+    // The owned grains with copies in contacts elsewhere, ascending, and
+    // each one's place among them (valid for those only): a glue touches
+    // these alone.
     std::vector<unsigned int>              shared_owned, shared_slot;
     std::vector<double>                    glue_sum;
     std::vector<Contact::GrainPair<dim>>   pairs;
@@ -185,6 +200,13 @@ namespace ImmersedGrains
 
     void
     keep_own_contacts();
+
+    /**
+     * Splits the mass of each grain over its copies that are in contacts
+     * (after keep_own_contacts()) and makes the glue's lists.
+     */
+    void
+    split_masses(Contact::GrainArrays<dim> &grains);
 
     /** Averages the velocities of every grain's copies (mass splitting). */
     void
