@@ -576,7 +576,7 @@ namespace ImmersedGrains
       };
       // Subspace corrections as in ContactSolver::solve(); the copies are
       // glued where they run, as they need.
-      Contact::SubspaceSchedule schedule(prm.subspace_interval);
+      Contact::SubspaceSchedule schedule(prm.subspace_interval, n_ranks > 1);
       const auto                correct = [&]()
       {
         schedule.record(result.iterations,

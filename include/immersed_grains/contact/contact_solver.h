@@ -119,18 +119,29 @@ namespace ImmersedGrains
      * When the Gauss-Seidel iterations run subspace corrections
      * (ContactSolver::subspace_correction()), in ContactSolver::solve() and
      * in a distributed caller alike: after every interval sweeps, and once
-     * when the sweeps' test is first passed (after the corrections due by
-     * then, if any: waiting for the next one cost up to interval sweeps of
-     * a step already solved, and on several ranks, where the copies' glue
-     * slows the sweeps, nearly every step hit it). A step is solved
+     * when the sweeps' test is passed before any has run. A step is solved
      * when the sweeps' test is passed and the last correction found
      * (almost) nothing left to lower (ContactSolver::settled_by(); such a
      * correction only tests and moves nothing).
+     *
+     * On several ranks (@p confirm_after_corrections) the first passed
+     * test is confirmed at once also after corrections that were due: there
+     * the copies' glue slows the sweeps, so nearly every step passes only
+     * after the first due correction and would sweep on to the next one,
+     * up to interval sweeps and their exchanges for a step already solved
+     * (two ranks: 24 sweeps per grain sub-step where they took 44 on the
+     * million-grain suspension, doc/performance.md). On one rank the same
+     * rule would save less (21 sweeps where 29, 11 % of the contacts' time
+     * there: the confirming correction's conjugate gradients cost much of
+     * what the sweeps saved do) and would move every frictionless scene's
+     * path within the tolerance; it is kept as it was.
      */
     struct SubspaceSchedule
     {
-      explicit SubspaceSchedule(const unsigned int interval)
+      explicit SubspaceSchedule(const unsigned int interval,
+                                const bool confirm_after_corrections = false)
           : interval(interval)
+          , confirm_after_corrections(confirm_after_corrections)
           , settled(interval == 0)
       {
       }
@@ -143,20 +154,24 @@ namespace ImmersedGrains
       }
 
       /// Whether the sweeps' test, just passed after @p iterations sweeps,
-      /// calls for a correction to confirm it: once per step, after a
-      /// sweep since the last correction.
+      /// calls for a correction to confirm it: once per step, before any
+      /// correction has run or (confirm_after_corrections) after a sweep
+      /// since the last one.
       bool
       confirm(const unsigned int iterations) const
       {
-        return !settled && !confirmed && iterations > last;
+        if (settled || confirmed)
+          return false;
+        return confirm_after_corrections ? iterations > last : !corrected;
       }
 
       /// Records a correction after @p iterations sweeps.
       void
       record(const unsigned int iterations, const bool settled_now)
       {
-        last    = iterations;
-        settled = settled_now;
+        last      = iterations;
+        corrected = true;
+        settled   = settled_now;
       }
 
       /// Records that the next correction confirms a passed test.
@@ -167,7 +182,9 @@ namespace ImmersedGrains
       }
 
       const unsigned int interval;
+      const bool         confirm_after_corrections;
       unsigned int       last      = 0;
+      bool               corrected = false;
       bool               confirmed = false;
       bool               settled;
     };
