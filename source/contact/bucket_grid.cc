@@ -179,7 +179,7 @@ namespace ImmersedGrains
       const auto [min_it, max_it] =
         std::minmax_element(radii.begin(), radii.end());
       const double max_radius = *max_it;
-      double       cut_radius = max_radius;
+      cut_radius              = max_radius;
       if (max_radius > 2 * *min_it)
       {
         // The 90th percentile, at least twice the smallest radius: a
@@ -291,44 +291,22 @@ namespace ImmersedGrains
             if (j == i || (!large && (j < i || j_large)) ||
                 (large && j < i && j_large))
               continue;
-            Tensor<1, dim>       d = xs[l] - xi;
-            std::array<int, dim> image{};
-            if (any_periodic)
-              for (unsigned int a = 0; a < dim; ++a)
-                if (periodic[a])
-                {
-                  if (d[a] > 0.5 * extent[a])
-                    image[a] = -1;
-                  else if (d[a] < -0.5 * extent[a])
-                    image[a] = 1;
-                  d[a] += image[a] * extent[a];
-                }
-            const double reach = ri + rs[l] + alert_distance;
-            const double dist2 = d.norm_square();
-            if (dist2 >= reach * reach)
-              continue;
-
-            // Stored with first < second: seen from j when j < i.
-            const bool     flip = j < i;
             GrainPair<dim> pair;
-            pair.first        = flip ? j : i;
-            pair.second       = flip ? i : j;
-            const double dist = std::sqrt(dist2);
-            if (dist > 0)
-              pair.normal = (flip ? -d : d) / dist;
-            else
-              pair.normal[0] = 1; // coincident centres: any unit vector
-            pair.gap = dist - ri - rs[l];
-            // d = (x_j + shift) - x_i with shift a whole number of periods.
-            for (unsigned int a = 0; a < dim; ++a)
-              if (periodic[a])
-              {
-                pair.shift[a] =
-                  (wrap_count[j][a] - wrap_count[i][a]) * -extent[a] +
-                  image[a] * extent[a];
-                if (flip)
-                  pair.shift[a] = -pair.shift[a];
-              }
+            if (!evaluate_pair<dim>(i,
+                                    j,
+                                    xi,
+                                    xs[l],
+                                    ri,
+                                    rs[l],
+                                    wrap_count[i],
+                                    wrap_count[j],
+                                    alert_distance,
+                                    periodic,
+                                    any_periodic,
+                                    extent,
+                                    pair))
+              continue;
+            const bool flip = j < i;
             (flip ? late_pairs : pairs).push_back(pair);
           }
         };
@@ -376,6 +354,67 @@ namespace ImmersedGrains
                            pairs.begin() + middle,
                            pairs.end(),
                            order);
+      }
+    }
+
+
+
+    template <int dim>
+    void
+    BucketGrid<dim>::grains_near(const Point<dim>          &x,
+                                 const double               distance,
+                                 std::vector<unsigned int> &grains) const
+    {
+      grains.clear();
+      if (bucket_start.empty())
+        return;
+      // The bucket coordinates on each axis, one more on either side than
+      // the distance needs: a centre on a bucket's edge may have been
+      // rounded into its neighbour.
+      std::array<std::vector<unsigned int>, dim> around;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        const int n = n_buckets_per_axis[d];
+        double    y = x[d] - grid_lower[d];
+        if (periodic[d])
+          y -= extent[d] * std::floor(y / extent[d]);
+        const double first = std::floor((y - distance) / bucket_size[d]) - 1,
+                     last  = std::floor((y + distance) / bucket_size[d]) + 1;
+        if (periodic[d] && last - first + 1 >= n)
+          for (int b = 0; b < n; ++b)
+            around[d].push_back(b);
+        else if (periodic[d])
+          for (double b = first; b <= last; ++b)
+            around[d].push_back(((static_cast<int>(b) % n) + n) % n);
+        else
+          for (double b = std::max(first, 0.); b <= std::min(last, n - 1.); ++b)
+            around[d].push_back(static_cast<unsigned int>(b));
+        if (around[d].empty())
+          return;
+      }
+      std::array<unsigned int, dim> stride;
+      stride[0] = 1;
+      for (unsigned int d = 1; d < dim; ++d)
+        stride[d] = stride[d - 1] * n_buckets_per_axis[d - 1];
+      std::array<unsigned int, dim> q{};
+      while (true)
+      {
+        unsigned int bucket = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          bucket += stride[d] * around[d][q[d]];
+        for (unsigned int l = bucket_start[bucket];
+             l < bucket_start[bucket + 1];
+             ++l)
+          grains.push_back(grain_in_order[l]);
+        unsigned int d = 0;
+        for (; d < dim; ++d)
+        {
+          if (++q[d] < around[d].size())
+            break;
+          q[d] = 0;
+        }
+        if (d >= dim)
+          break;
       }
     }
 

@@ -59,9 +59,9 @@ namespace ImmersedGrains
       , n_ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
       , friction(parameters.friction > 0)
       , geometry(geometry)
-      , grid(geometry.lower_corner,
-             geometry.upper_corner,
-             periodic_axes(geometry))
+      , neighbours(geometry.lower_corner,
+                   geometry.upper_corner,
+                   periodic_axes(geometry))
       , solver(parameters)
   {
     wall_boundary_ids = geometry.add_walls(walls);
@@ -517,7 +517,7 @@ namespace ImmersedGrains
     if (sweep_direction.norm() > 0)
       for (const auto &x : all_positions)
         g.sweep_key.push_back(x * sweep_direction);
-    grid.find_pairs(all_positions, g.radius, alert, pairs);
+    neighbours.find_pairs(all_positions, g.radius, ids, alert, pairs);
     walls.find_contacts(all_positions, g.radius, alert, wall_contacts);
     if (n_ranks > 1)
     {

@@ -5,6 +5,7 @@
 #include <deal.II/base/tensor.h>
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 namespace ImmersedGrains
@@ -36,6 +37,74 @@ namespace ImmersedGrains
       /// @p first. Zero unless the pair touches across a periodic face.
       Tensor<1, dim> shift;
     };
+
+    /**
+     * The pair of grain @p i (the one that searches) with grain @p j, from
+     * their centres wrapped into the box on the periodic axes (@p xi,
+     * @p xj: the positions minus @p wrap_i, @p wrap_j periods): true, with
+     * @p pair filled, where |x_j - x_i| - r_i - r_j < @p alert_distance for
+     * the nearest periodic image. BucketGrid and NeighbourList both build
+     * their pairs here, so that a pair comes out bit for bit the same from
+     * either, whichever of its grains searches.
+     */
+    template <int dim>
+    inline bool
+    evaluate_pair(const unsigned int           i,
+                  const unsigned int           j,
+                  const Point<dim>            &xi,
+                  const Point<dim>            &xj,
+                  const double                 ri,
+                  const double                 rj,
+                  const std::array<int, dim>  &wrap_i,
+                  const std::array<int, dim>  &wrap_j,
+                  const double                 alert_distance,
+                  const std::array<bool, dim> &periodic,
+                  const bool                   any_periodic,
+                  const Tensor<1, dim>        &extent,
+                  GrainPair<dim>              &pair)
+    {
+      Tensor<1, dim>       d = xj - xi;
+      std::array<int, dim> image{};
+      if (any_periodic)
+        for (unsigned int a = 0; a < dim; ++a)
+          if (periodic[a])
+          {
+            if (d[a] > 0.5 * extent[a])
+              image[a] = -1;
+            else if (d[a] < -0.5 * extent[a])
+              image[a] = 1;
+            d[a] += image[a] * extent[a];
+          }
+      const double reach = ri + rj + alert_distance;
+      const double dist2 = d.norm_square();
+      if (dist2 >= reach * reach)
+        return false;
+
+      // Stored with first < second: seen from j when j < i.
+      const bool flip   = j < i;
+      pair.first        = flip ? j : i;
+      pair.second       = flip ? i : j;
+      const double dist = std::sqrt(dist2);
+      if (dist > 0)
+        pair.normal = (flip ? -d : d) / dist;
+      else
+      {
+        pair.normal    = Tensor<1, dim>();
+        pair.normal[0] = 1; // coincident centres: any unit vector
+      }
+      pair.gap = dist - ri - rj;
+      // d = (x_j + shift) - x_i with shift a whole number of periods.
+      pair.shift = Tensor<1, dim>();
+      for (unsigned int a = 0; a < dim; ++a)
+        if (periodic[a])
+        {
+          pair.shift[a] =
+            (wrap_j[a] - wrap_i[a]) * -extent[a] + image[a] * extent[a];
+          if (flip)
+            pair.shift[a] = -pair.shift[a];
+        }
+      return true;
+    }
 
     /**
      * Uniform bucket grid ("cell list") for the grain-grain neighbour search,
@@ -80,6 +149,26 @@ namespace ImmersedGrains
                  const double                   alert_distance,
                  std::vector<GrainPair<dim>>   &pairs);
 
+      /// The radius above which a grain counts as large in the last
+      /// find_pairs() call: a large grain searches for its pairs with the
+      /// small grains of lower index, which skip it.
+      double
+      large_radius() const
+      {
+        return cut_radius;
+      }
+
+      /**
+       * Fills @p grains with the grains of the last find_pairs() call (their
+       * indices there) whose buckets lie within @p distance of @p x (on a
+       * periodic axis, of any of its images): every grain of that call
+       * whose centre was within @p distance of @p x is among them.
+       */
+      void
+      grains_near(const Point<dim>          &x,
+                  double                     distance,
+                  std::vector<unsigned int> &grains) const;
+
       /// Number of buckets per axis chosen by the last find_pairs() call.
       const std::array<unsigned int, dim> &
       n_buckets() const;
@@ -94,6 +183,8 @@ namespace ImmersedGrains
       // in a large domain gets buckets of its own scale.
       Point<dim>     grid_lower;
       Tensor<1, dim> grid_extent;
+
+      double cut_radius = 0;
 
       std::array<unsigned int, dim> n_buckets_per_axis;
       Tensor<1, dim>                bucket_size;

@@ -4,8 +4,8 @@
 #include <deal.II/base/bounding_box.h>
 #include <deal.II/base/mpi.h>
 
-#include <immersed_grains/contact/bucket_grid.h>
 #include <immersed_grains/contact/contact_solver.h>
+#include <immersed_grains/contact/neighbour_list.h>
 #include <immersed_grains/contact/walls.h>
 #include <immersed_grains/mesh/geometry.h>
 
@@ -146,8 +146,10 @@ namespace ImmersedGrains
     const bool           friction;
     const Geometry<dim> &geometry;
 
-    Contact::BucketGrid<dim> grid;
-    Contact::Walls<dim>      walls;
+    // The grain-grain search, kept over sub-steps while the grains stay
+    // within its skin.
+    Contact::NeighbourList<dim> neighbours;
+    Contact::Walls<dim>         walls;
     // The boundary id of each wall, by wall number.
     std::vector<dealii::types::boundary_id> wall_boundary_ids;
     Contact::ContactSolver<dim>             solver;
