@@ -48,6 +48,11 @@ namespace ImmersedGrains
      * either, whichever of its grains searches.
      */
     template <int dim>
+#if defined(__GNUC__)
+    // Runs in the search's innermost loop, where it rejects most grains:
+    // inlined there rather than called.
+    __attribute__((always_inline))
+#endif
     inline bool
     evaluate_pair(const unsigned int           i,
                   const unsigned int           j,
