@@ -131,8 +131,9 @@ namespace
       {
         const unsigned int i = below(x.size());
         Point<dim>         y;
-        for (unsigned int d = 0; d < dim; ++d)
-          y[d] = uniform(0, box_length);
+        for (unsigned int d = 0; d < dim; ++d) // some outside the box
+          y[d] =
+            periodic[d] ? uniform(0, box_length) : uniform(-1, box_length + 1);
         x.insert(x.begin() + i, y);
         r.insert(r.begin() + i, r[(i + 1) % r.size()]);
         id.insert(id.begin() + i, next_id++);

@@ -387,7 +387,10 @@ namespace ImmersedGrains
           for (double b = first; b <= last; ++b)
             around[d].push_back(((static_cast<int>(b) % n) + n) % n);
         else
-          for (double b = std::max(first, 0.); b <= std::min(last, n - 1.); ++b)
+          // Grains beyond the box on this axis lie in its outer buckets.
+          for (double b = std::min(std::max(first, 0.), n - 1.);
+               b <= std::min(std::max(last, 0.), n - 1.);
+               ++b)
             around[d].push_back(static_cast<unsigned int>(b));
         if (around[d].empty())
           return;

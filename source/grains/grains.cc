@@ -1266,6 +1266,24 @@ namespace ImmersedGrains
 
 
   template <int dim>
+  std::pair<unsigned long, unsigned long>
+  Grains<dim>::neighbour_searches() const
+  {
+    unsigned long counts[2] = {0, 0};
+    if (contacts)
+    {
+      counts[0] = contacts->neighbour_list().n_calls();
+      counts[1] = contacts->neighbour_list().n_searches();
+    }
+    dealii::Utilities::MPI::max(dealii::ArrayView<const unsigned long>(counts,
+                                                                       2),
+                                comm,
+                                dealii::ArrayView<unsigned long>(counts, 2));
+    return {counts[0], counts[1]};
+  }
+
+
+  template <int dim>
   void
   Grains<dim>::record_boundary_contact_forces()
   {

@@ -843,6 +843,14 @@ namespace ImmersedGrains
             << "iterations in " << capped_contact_steps << " step"
             << (capped_contact_steps > 1 ? "s" : "")
             << " of this run (contact_converged = 0 in statistics.csv)\n";
+    if (grains)
+    {
+      const auto [solves, searches] = grains->neighbour_searches();
+      if (solves > 0)
+        pcout << "  contacts: " << solves << " solves, " << searches
+              << " of them searched for grain pairs anew (the others kept "
+              << "the neighbour list)\n";
+    }
     pcout << "  done: " << step << " steps, wall time "
           << wall_clock() - wall_start << " s; output in " << output_directory
           << "/\n";

@@ -125,6 +125,13 @@ namespace ImmersedGrains
       return solver;
     }
 
+    /** The grain-grain neighbour search of this rank. */
+    const Contact::NeighbourList<dim> &
+    neighbour_list() const
+    {
+      return neighbours;
+    }
+
     /** The contacts this rank solved in the last step, with their forces. */
     std::vector<ContactForce>
     contact_forces() const;

@@ -20,6 +20,7 @@
 #include <memory>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace ImmersedGrains
@@ -361,6 +362,12 @@ namespace ImmersedGrains
     /** Contacts solved on this rank in the last step. */
     std::vector<ContactForce>
     contact_forces() const;
+
+    /** The contact solves since the start and how many of them searched
+     *  for grain-grain pairs anew (the others kept the neighbour list);
+     *  the largest count over the ranks (collective). */
+    std::pair<unsigned long, unsigned long>
+    neighbour_searches() const;
 
     /** From now on, each step sums the impulse its contacts (all its
      *  sub-steps) give each boundary, for boundary_contact_forces(). */
