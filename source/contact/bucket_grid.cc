@@ -9,6 +9,28 @@ namespace ImmersedGrains
 {
   namespace Contact
   {
+    namespace
+    {
+      // Steps @p q to the next combination of one bucket coordinate per
+      // axis from @p around, axes below @p first_axis fixed: false after
+      // the last.
+      template <int dim>
+      bool
+      next_bucket(std::array<unsigned int, dim>                    &q,
+                  const std::array<std::vector<unsigned int>, dim> &around,
+                  const unsigned int                                first_axis)
+      {
+        for (unsigned int d = first_axis; d < dim; ++d)
+        {
+          if (++q[d] < around[d].size())
+            return true;
+          q[d] = 0;
+        }
+        return false;
+      }
+    } // namespace
+
+
     template <int dim>
     BucketGrid<dim>::BucketGrid(const Point<dim>            &lower,
                                 const Point<dim>            &upper,
@@ -325,14 +347,7 @@ namespace ImmersedGrains
           else
             for (const unsigned int b : around[0])
               scan(bucket_start[row + b], bucket_start[row + b + 1]);
-          unsigned int d = 1;
-          for (; d < dim; ++d)
-          {
-            if (++q[d] < around[d].size())
-              break;
-            q[d] = 0;
-          }
-          if (d >= dim)
+          if (!next_bucket<dim>(q, around, 1))
             break;
         }
         std::sort(pairs.begin() + first,
@@ -409,14 +424,7 @@ namespace ImmersedGrains
              l < bucket_start[bucket + 1];
              ++l)
           grains.push_back(grain_in_order[l]);
-        unsigned int d = 0;
-        for (; d < dim; ++d)
-        {
-          if (++q[d] < around[d].size())
-            break;
-          q[d] = 0;
-        }
-        if (d >= dim)
+        if (!next_bucket<dim>(q, around, 0))
           break;
       }
     }
