@@ -79,9 +79,9 @@ namespace ImmersedGrains
         return candidates.size();
       }
 
-      /// A quarter of the smallest grain's diameter: measured on the
-      /// million-grain suspension and the 3D falling cloud
-      /// (doc/contacts.md, "Neighbour search").
+      /// A quarter of the smallest grain's diameter: chosen on the 3D
+      /// falling cloud and the 10^5-grain suspension (doc/contacts.md,
+      /// "Kept over sub-steps").
       static constexpr double default_skin = 0.25;
 
     private:
