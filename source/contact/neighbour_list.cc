@@ -45,6 +45,9 @@ namespace ImmersedGrains
     {
       const unsigned int n = positions.size();
       ++searches;
+      // Only the indices are kept: the full records of the wider search,
+      // 64 bytes each in 3D, would stay allocated between searches.
+      std::vector<GrainPair<dim>> search_pairs;
       grid.find_pairs(positions, radii, alert_distance + skin, search_pairs);
       candidates.resize(search_pairs.size());
       for (std::size_t k = 0; k < search_pairs.size(); ++k)

@@ -72,13 +72,6 @@ namespace ImmersedGrains
         return searches;
       }
 
-      /// Candidate pairs of the last search.
-      std::size_t
-      n_candidates() const
-      {
-        return candidates.size();
-      }
-
       /// A quarter of the smallest grain's diameter: chosen on the 3D
       /// falling cloud and the 10^5-grain suspension (doc/contacts.md,
       /// "Kept over sub-steps").
@@ -111,8 +104,7 @@ namespace ImmersedGrains
       {
         unsigned int first, second;
       };
-      std::vector<Candidate>      candidates;
-      std::vector<GrainPair<dim>> search_pairs;
+      std::vector<Candidate> candidates;
 
       // The search's index of an id: dense where the ids allow.
       std::vector<unsigned int>                           index_of_id;
