@@ -3,6 +3,7 @@
 
 #include <immersed_grains/fluid/block_preconditioner.h>
 #include <immersed_grains/fluid/coarse_schur_correction.h>
+#include <immersed_grains/linear_algebra/ghost_exchange.h>
 
 #include <Epetra_MultiVector.h>
 #include <Teuchos_ParameterList.hpp>
@@ -231,7 +232,9 @@ namespace ImmersedGrains
     auto        &Mp   = cg_product;
     const double stop = settings.pressure_mass_tolerance * src.l2_norm();
     dst               = 0;
-    r                 = src;
+    // A copy without deal.II's comparison of the two vectors' maps (a
+    // reduction over the ranks at each of these inner solves).
+    GhostExchange::copy(src, r);
     pressure_mass_ilu.vmult(z, r);
     p              = z;
     double r_dot_z = r * z;

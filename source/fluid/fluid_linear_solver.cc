@@ -409,7 +409,7 @@ namespace ImmersedGrains
         system_matrix.vmult(residual, newton_update);
         residual.sadd(-1.0, 1.0, system_rhs);
         preconditioner->vmult(estimate, residual);
-        velocity = solution;
+        ghost_exchange.to_owned(solution, velocity);
         velocity.block(0).add(1.0, newton_update.block(0));
         const double error = estimate.block(0).linfty_norm();
         const double scale = velocity.block(0).linfty_norm();

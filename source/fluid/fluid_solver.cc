@@ -625,7 +625,11 @@ namespace ImmersedGrains
     old_old_solution.reinit(solution);
     system_rhs.reinit(owned_partitioning, mpi_communicator);
     reaction_diagonal.reinit(owned_partitioning, mpi_communicator);
-    newton_update.reinit(owned_partitioning, mpi_communicator);
+    // The two share Epetra's maps with the exchange's import, so that
+    // Epetra recognises them at once.
+    step_iterate.reinit(owned_partitioning, mpi_communicator);
+    newton_update.reinit(step_iterate);
+    ghost_exchange.reinit(step_iterate, solution);
     cell_scatter = std::make_unique<CellScatter<dim>>();
     cell_scatter->reinit(dof_handler,
                          system_coupling,
@@ -1013,8 +1017,8 @@ namespace ImmersedGrains
     else
       bdf = {{1, -1, 0}};
 
-    old_old_solution = old_solution;
-    old_solution     = solution;
+    GhostExchange::copy(old_solution, old_old_solution);
+    GhostExchange::copy(solution, old_solution);
     if (geometry.has_open_boundary())
       sample_open_pressure();
 
@@ -1025,17 +1029,16 @@ namespace ImmersedGrains
       dealii::TimerOutput::Scope scope(timer, "fluid: setup");
       make_constraints();
     }
-    VectorType iterate(owned_partitioning, mpi_communicator);
-    iterate = old_solution;
+    VectorType &iterate = step_iterate;
+    ghost_exchange.to_owned(old_solution, iterate);
     if (second_order && parameters.time_derivative)
     {
       iterate *= (1 + omega);
       VectorType older(owned_partitioning, mpi_communicator);
-      older = old_old_solution;
+      ghost_exchange.to_owned(old_old_solution, older);
       iterate.add(-omega, older);
     }
-    solution_constraints.distribute(iterate);
-    solution = iterate;
+    ghost_exchange.distribute(solution_constraints, iterate, solution);
 
     StepStatistics     stats;
     const unsigned int builds_before = builds;
@@ -1074,9 +1077,9 @@ namespace ImmersedGrains
                  0.1 * parameters.linear_tolerance * rhs_norm),
         fresh_preconditioner);
       ++stats.nonlinear_iterations;
-      update_constraints.distribute(newton_update);
+      ghost_exchange.distribute(update_constraints, newton_update, solution);
       iterate.add(1.0, newton_update);
-      solution = iterate;
+      ghost_exchange.to_ghosted(iterate, solution);
       if (linear)
       {
         converged = true;
@@ -1093,7 +1096,7 @@ namespace ImmersedGrains
                   "time step or use Linearization = Newton."));
 
     normalize_pressure(iterate);
-    solution = iterate;
+    ghost_exchange.to_ghosted(iterate, solution);
     ++steps_done;
     return stats;
   }

@@ -689,8 +689,16 @@ namespace ImmersedGrains
     const std::string resume_from = resume_point();
     // Created only now: a TimerOutput alive while a parse error unwinds
     // would print its own complaint beside the one-line message.
-    timer = std::make_unique<dealii::TimerOutput>(
-      comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times);
+    // Each rank times its own phases; the summary gathers them once at the
+    // end (print_wall_time_statistics). Given the communicator, every
+    // section's entry and exit would be a barrier and a reduction, which
+    // the grains' sub-steps enter tens of thousands of times: on the 2D
+    // cloud's two ranks, 7 % of the run (doc/performance.md, "Two
+    // ranks").
+    timer =
+      std::make_unique<dealii::TimerOutput>(pcout,
+                                            dealii::TimerOutput::never,
+                                            dealii::TimerOutput::wall_times);
     bool in_step = false;
     try
     {

@@ -11,6 +11,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <immersed_grains/linear_algebra/ghost_exchange.h>
 #include <immersed_grains/mesh/geometry.h>
 
 #include <array>
@@ -149,14 +150,19 @@ namespace ImmersedGrains
     dealii::TrilinosWrappers::SparseMatrix                   matrix;
     dealii::TrilinosWrappers::SparseMatrix                   mass_matrix;
     Vector                                                   lumped_inverse;
+    // Vectors of the two layouts that every vector of this filter copies
+    // (sharing Epetra's maps), and the copies between the layouts.
+    Vector        owned_template, ghosted_template;
+    GhostExchange ghost_exchange;
     // The inverse of the matrix's diagonal: the conjugate gradients' Jacobi
     // preconditioner.
     Vector diagonal_inverse;
     Vector weights;
     // A plain lumped projection is a division, not a linear solve.
     bool diagonal = false;
-    // On one rank and up to direct_limit() unknowns, A's sparse LU
-    // (setup()); solve() then costs two triangular solves per field.
+    // Up to direct_limit() unknowns (a rank's share of it on several
+    // ranks), A's sparse LU, on the first rank (setup()); solve() then
+    // costs two triangular solves per field.
     std::unique_ptr<Epetra_LinearProblem> direct_problem;
     std::unique_ptr<Amesos_BaseSolver>    direct_solver;
   };

@@ -18,6 +18,7 @@
 
 #include <immersed_grains/fluid/fluid_parameters.h>
 #include <immersed_grains/fluid/mixture_fields.h>
+#include <immersed_grains/linear_algebra/ghost_exchange.h>
 #include <immersed_grains/mesh/cell_point_shapes.h>
 #include <immersed_grains/mesh/geometry.h>
 
@@ -411,6 +412,10 @@ namespace ImmersedGrains
     VectorType old_old_solution; // ghosted, t^{n-1}
     VectorType system_rhs;       // owned: minus the residual
     VectorType newton_update;    // owned
+    // The time step's iterate (owned), and the copies between it and the
+    // ghosted vectors above.
+    VectorType    step_iterate;
+    GhostExchange ghost_exchange;
 
     // Shape functions at grain positions (point_values); the Q2 ones also at
     // the Gauss points for cell means.
