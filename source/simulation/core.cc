@@ -692,9 +692,8 @@ namespace ImmersedGrains
     // Each rank times its own phases; the summary gathers them once at the
     // end (print_wall_time_statistics). Given the communicator, every
     // section's entry and exit would be a barrier and a reduction, which
-    // the grains' sub-steps enter tens of thousands of times: on the 2D
-    // cloud's two ranks, 7 % of the run (doc/performance.md, "Two
-    // ranks").
+    // the grains' sub-steps enter tens of thousands of times
+    // (doc/performance.md, "Two ranks").
     timer =
       std::make_unique<dealii::TimerOutput>(pcout,
                                             dealii::TimerOutput::never,

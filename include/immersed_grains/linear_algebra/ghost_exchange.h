@@ -20,15 +20,15 @@ namespace ImmersedGrains
    * deal.II's assignment between the two layouts first compares their
    * Epetra maps (a reduction over all ranks) and then builds a new
    * Epetra_Import (the remote indices exchanged and looked up) at every
-   * call: on the 2D cloud's two ranks these took a tenth of the run where
-   * the copies' data is a few kilobytes (doc/performance.md, "Two ranks").
-   * Here the import is built in reinit(); the owned values are copied by
-   * local positions, and only the ghosts travel. The copies are exact, as
-   * deal.II's are.
+   * call, where the data copied is a few kilobytes on a 2D scene
+   * (doc/performance.md, "Two ranks"). Here the import is built in
+   * reinit(); the owned values are copied by local positions, and only the
+   * ghosts travel. The copies are exact, as deal.II's are.
    *
-   * The vectors given must have the layout given to reinit(): this is
-   * checked by local lengths in release builds and by the maps in debug
-   * builds.
+   * The vectors given must have the layout given to reinit(): their local
+   * lengths are checked, and Epetra checks the import's maps. Vectors that
+   * share the templates' Epetra maps (copies of them) pass Epetra's check
+   * at once; others are compared entry by entry.
    */
   class GhostExchange
   {
