@@ -26,11 +26,7 @@ namespace ImmersedGrains
     if (settings.velocity_ilu)
     {
       // One layer of overlap, as for the AMG's smoother below.
-      dealii::TrilinosWrappers::PreconditionILU::AdditionalData data(0,
-                                                                     0.,
-                                                                     1.,
-                                                                     1);
-      velocity_ilu.initialize(system_matrix.block(0, 0), data);
+      velocity_ilu.initialize(system_matrix.block(0, 0), 1);
     }
     else
     {

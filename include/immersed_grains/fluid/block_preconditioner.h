@@ -5,6 +5,8 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_precondition.h>
 
+#include <immersed_grains/linear_algebra/restricted_schwarz_ilu.h>
+
 #include <vector>
 
 namespace ImmersedGrains
@@ -109,7 +111,7 @@ namespace ImmersedGrains
     velocity_preconditioner() const;
 
     dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
-    dealii::TrilinosWrappers::PreconditionILU velocity_ilu;
+    RestrictedSchwarzILU                      velocity_ilu;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;
     dealii::TrilinosWrappers::PreconditionAMG pressure_laplace_amg;
     bool                                      use_mass    = false;
