@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <vector>
 
 namespace ImmersedGrains
 {
@@ -13,6 +15,54 @@ namespace ImmersedGrains
   {
     constexpr int glue_to_owner_tag   = 7411;
     constexpr int glue_from_owner_tag = 7412;
+    constexpr int flags_tag           = 7413;
+    constexpr int split_tag           = 7414;
+
+    /**
+     * Sends @p outgoing[q] to each rank q and receives from each rank of
+     * @p incoming_sizes as many numbers as it names: both sides know whom
+     * they hear from and how much (the ghosts' lists, made in
+     * exchange_ghosts()). deal.II's some_to_some() first finds the senders
+     * with a collective and takes a collective mutex: two collectives per
+     * call, and a contact solve made two such calls besides the one whose
+     * senders are not known.
+     */
+    std::map<unsigned int, std::vector<unsigned int>>
+    exchange_known(
+      const std::map<unsigned int, std::vector<unsigned int>> &outgoing,
+      const std::map<unsigned int, std::size_t>               &incoming_sizes,
+      const int                                                tag,
+      const MPI_Comm                                           comm)
+    {
+      std::map<unsigned int, std::vector<unsigned int>> incoming;
+      std::vector<MPI_Request>                          requests;
+      requests.reserve(outgoing.size() + incoming_sizes.size());
+      for (const auto &[q, n] : incoming_sizes)
+      {
+        auto &buffer = incoming[q];
+        buffer.resize(n);
+        requests.emplace_back();
+        const int error = MPI_Irecv(
+          buffer.data(), n, MPI_UNSIGNED, q, tag, comm, &requests.back());
+        AssertThrowMPI(error);
+      }
+      for (const auto &[q, values] : outgoing)
+      {
+        requests.emplace_back();
+        const int error = MPI_Isend(values.data(),
+                                    values.size(),
+                                    MPI_UNSIGNED,
+                                    q,
+                                    tag,
+                                    comm,
+                                    &requests.back());
+        AssertThrowMPI(error);
+      }
+      const int error =
+        MPI_Waitall(requests.size(), requests.data(), MPI_STATUSES_IGNORE);
+      AssertThrowMPI(error);
+      return incoming;
+    }
 
     template <int dim>
     std::array<bool, dim>
@@ -280,7 +330,13 @@ namespace ImmersedGrains
           glue_ghosts[q].push_back(j);
       }
     }
-    const auto flags_in = dealii::Utilities::MPI::some_to_some(comm, flags_out);
+    // The flags come back from the ranks this one sent grains to, one a
+    // grain.
+    std::map<unsigned int, std::size_t> flags_sizes;
+    for (const auto &[q, list] : send_lists)
+      flags_sizes[q] = list.size();
+    const auto flags_in =
+      exchange_known(flags_out, flags_sizes, flags_tag, comm);
 
     owner_in_contact.assign(in_contact.begin(), in_contact.begin() + n_owned);
     copies.assign(n_owned, 0);
@@ -304,7 +360,12 @@ namespace ImmersedGrains
     for (const auto &[q, list] : glue_owned)
       for (const unsigned int i : list)
         split_out[q].push_back(copies[i]);
-    const auto split_in = dealii::Utilities::MPI::some_to_some(comm, split_out);
+    // The owners of this rank's ghosts in contacts answer, one a ghost.
+    std::map<unsigned int, std::size_t> split_sizes;
+    for (const auto &[q, list] : glue_ghosts)
+      split_sizes[q] = list.size();
+    const auto split_in =
+      exchange_known(split_out, split_sizes, split_tag, comm);
     for (const auto &[q, split] : split_in)
     {
       const auto &list = glue_ghosts.at(q);
