@@ -1,9 +1,15 @@
+#include <deal.II/base/mpi.h>
 #include <deal.II/lac/trilinos_index_access.h>
 
 #include <immersed_grains/fluid/cell_scatter.h>
+#include <immersed_grains/linear_algebra/owned_vector_memory.h>
+
+#include <mpi.h>
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <tuple>
 
 namespace ImmersedGrains
 {
@@ -26,6 +32,16 @@ namespace ImmersedGrains
         n -= half;
       }
       return first + (*first < value ? 1 : 0);
+    }
+
+    // The kind of an entry of another rank's row: bit 0 set for the
+    // right-hand side, bits 1 and 2 the blocks of its row and column.
+    std::uint8_t
+    remote_code(const bool         rhs,
+                const unsigned int row_block,
+                const unsigned int column_block)
+    {
+      return (rhs ? 1 : 0) | (row_block << 1) | (column_block << 2);
     }
 
     // What AffineConstraints puts on a constrained row's diagonal where the
@@ -74,7 +90,23 @@ namespace ImmersedGrains
     for (auto &row : row_values)
       for (auto &values : row)
         values.clear();
+    for (auto &row : row_indices)
+      for (auto &indices : row)
+        indices.clear();
+    for (auto &row : row_lengths)
+      for (auto &lengths : row)
+        lengths.clear();
     vector_values = {{nullptr, nullptr}};
+    condensed_remote_start.clear();
+    remote_visits.clear();
+    remote_slots.clear();
+    exchange_remote = false;
+    send_ranks.clear();
+    send_offsets.clear();
+    send_values.clear();
+    receive_ranks.clear();
+    receive_targets.clear();
+    receive_values.clear();
     system_matrix = nullptr;
     system_vector = nullptr;
   }
@@ -86,6 +118,14 @@ namespace ImmersedGrains
   {
     return k < direct_index.size() &&
            (direct_index[k] >= 0 || condensed_index[k] >= 0);
+  }
+
+
+  template <int dim>
+  bool
+  CellScatter<dim>::exchanges_remote_rows() const
+  {
+    return exchange_remote;
   }
 
 
@@ -112,8 +152,23 @@ namespace ImmersedGrains
     VectorType                                         &vector)
   {
     clear();
-    system_matrix  = &matrix;
-    system_vector  = &vector;
+    system_matrix = &matrix;
+    system_vector = &vector;
+    find_positions(dof_handler, coupling, constraints, matrix, vector);
+    // Every rank, whatever find_positions() found: collective.
+    setup_remote_exchange(dof_handler, matrix, vector);
+  }
+
+
+  template <int dim>
+  void
+  CellScatter<dim>::find_positions(
+    const dealii::DoFHandler<dim>                      &dof_handler,
+    const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
+    const dealii::AffineConstraints<double>            &constraints,
+    MatrixType                                         &matrix,
+    VectorType                                         &vector)
+  {
     const auto &fe = dof_handler.get_fe();
     dofs_per_cell  = fe.n_dofs_per_cell();
     if (dofs_per_cell >= skip || matrix.n_block_rows() != 2 ||
@@ -121,8 +176,6 @@ namespace ImmersedGrains
       return;
 
     // Epetra's rows: values, local column indices, lengths.
-    std::array<std::array<std::vector<int *>, 2>, 2> row_indices;
-    std::array<std::array<std::vector<int>, 2>, 2>   row_lengths;
     for (unsigned int b = 0; b < 2; ++b)
       for (unsigned int c = 0; c < 2; ++c)
       {
@@ -247,8 +300,7 @@ namespace ImmersedGrains
       {
         direct_index.push_back(-1);
         condensed_index.push_back(
-          add_condensed_cell(
-            dofs, constraints, coupling, matrix, row_indices, row_lengths) ?
+          add_condensed_cell(dofs, constraints, coupling, matrix) ?
             static_cast<int>(condensed_targets_start.size()) - 1 :
             -1);
       }
@@ -259,12 +311,10 @@ namespace ImmersedGrains
   template <int dim>
   bool
   CellScatter<dim>::add_condensed_cell(
-    const std::vector<dealii::types::global_dof_index>     &dofs,
-    const dealii::AffineConstraints<double>                &constraints,
-    const dealii::Table<2, dealii::DoFTools::Coupling>     &coupling,
-    const MatrixType                                       &matrix,
-    const std::array<std::array<std::vector<int *>, 2>, 2> &row_indices,
-    const std::array<std::array<std::vector<int>, 2>, 2>   &row_lengths)
+    const std::vector<dealii::types::global_dof_index> &dofs,
+    const dealii::AffineConstraints<double>            &constraints,
+    const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
+    const MatrixType                                   &matrix)
   {
     const auto &blocks = matrix.get_row_indices();
     // The position of column @p dof in the row @p row of block (b, c), or
@@ -393,6 +443,33 @@ namespace ImmersedGrains
           entries.push_back({static_cast<std::uint16_t>(b),
                              static_cast<std::uint16_t>(found - begin)});
         }
+
+    // The entries of other ranks' rows in the order add_condensed() visits
+    // them: each remote row's entries and its right-hand side, then the
+    // remote constrained rows' diagonals.
+    condensed_remote_start.push_back(remote_visits.size());
+    for (std::size_t a = 0, e = 0; a < targets.size(); e += lengths[a], ++a)
+    {
+      if (targets[a].row >= 0)
+        continue;
+      for (unsigned int k = 0; k < lengths[a]; ++k)
+      {
+        const Target &column = targets[entries[e + k].column];
+        remote_visits.push_back(
+          {remote_code(false, targets[a].block, column.block),
+           targets[a].index,
+           column.index});
+      }
+      remote_visits.push_back(
+        {remote_code(true, targets[a].block, 0), targets[a].index, 0});
+    }
+    for (const Diagonal &diagonal : diagonals)
+      if (diagonal.row < 0)
+      {
+        const unsigned int block = dof_block[diagonal.local_dof];
+        remote_visits.push_back(
+          {remote_code(false, block, block), diagonal.index, diagonal.index});
+      }
 
     condensed_targets_start.push_back(condensed_targets.size());
     condensed_targets.insert(condensed_targets.end(),
@@ -534,12 +611,23 @@ namespace ImmersedGrains
     const Entry         *entry = &condensed_entries[condensed_entries_start[c]];
     const std::uint16_t *lengths =
       &condensed_row_lengths[condensed_targets_start[c]];
+    // Where this cell's entries of other ranks' rows are summed.
+    const std::uint32_t *slot =
+      exchange_remote ? remote_slots.data() + condensed_remote_start[c] :
+                        nullptr;
     for (std::size_t a = 0; a < n_targets; ++a)
     {
       const Target &row  = targets[a];
       const double *sums = &condensed_matrix[a * n_targets];
       if (row.row < 0)
       {
+        if (exchange_remote)
+        {
+          for (unsigned int k = 0; k < lengths[a]; ++k, ++entry)
+            send_values[*slot++] += sums[entry->column];
+          send_values[*slot++] += condensed_rhs[a];
+          continue;
+        }
         add_to_remote_row(
           row, entry, lengths[a], sums, targets, condensed_rhs[a]);
         entry += lengths[a];
@@ -568,7 +656,9 @@ namespace ImmersedGrains
       double             value =
         std::abs(cell_matrix(diagonal.local_dof, diagonal.local_dof));
       value = value != 0 ? value : mean;
-      if (diagonal.row < 0)
+      if (diagonal.row < 0 && exchange_remote)
+        send_values[*slot++] += value;
+      else if (diagonal.row < 0)
         system_matrix->block(block, block)
           .add(diagonal.index, diagonal.index, value);
       else
@@ -607,6 +697,230 @@ namespace ImmersedGrains
                true,
                false);
     system_vector->block(row.block).add(1, &row.index, &rhs);
+  }
+
+
+  template <int dim>
+  void
+  CellScatter<dim>::setup_remote_exchange(
+    const dealii::DoFHandler<dim> &dof_handler,
+    MatrixType                    &matrix,
+    VectorType                    &vector)
+  {
+    const MPI_Comm comm = matrix.get_mpi_communicator();
+    if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
+    {
+      remote_visits.clear();
+      return;
+    }
+
+    // Only where no cell on any rank writes through deal.II: its matrix
+    // and vector then receive nothing non-local and need no compress().
+    bool ready = !row_values[0][0].empty();
+    {
+      unsigned int owned = 0;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          ready = ready && is_direct(owned++);
+      ready = ready || owned == 0;
+    }
+
+    // The owner of each remote row, from the ranks' owned ranges of each
+    // block (deal.II's compute_index_owner() took 2 s per mesh of the 3D
+    // cloud on two ranks, most of it in a reduction over the whole index
+    // space).
+    std::array<std::vector<std::tuple<dealii::types::global_dof_index,
+                                      dealii::types::global_dof_index,
+                                      unsigned int>>,
+               2>
+      owned_ranges;
+    for (unsigned int b = 0; b < 2; ++b)
+    {
+      const dealii::IndexSet owned =
+        matrix.block(b, b).locally_owned_range_indices();
+      std::vector<std::pair<dealii::types::global_dof_index,
+                            dealii::types::global_dof_index>>
+        mine;
+      for (auto i = owned.begin_intervals(); i != owned.end_intervals(); ++i)
+        mine.emplace_back(*i->begin(), i->last() + 1);
+      const auto all = dealii::Utilities::MPI::all_gather(comm, mine);
+      for (unsigned int q = 0; q < all.size(); ++q)
+        for (const auto &[first, end] : all[q])
+          owned_ranges[b].emplace_back(first, end, q);
+      std::sort(owned_ranges[b].begin(), owned_ranges[b].end());
+    }
+    const auto owner_of =
+      [&](const unsigned int b, const dealii::types::global_dof_index row)
+    {
+      const auto &ranges = owned_ranges[b];
+      auto        range =
+        std::upper_bound(ranges.begin(),
+                         ranges.end(),
+                         row,
+                         [](const dealii::types::global_dof_index i,
+                            const auto &r) { return i < std::get<0>(r); });
+      Assert(range != ranges.begin(), dealii::ExcInternalError());
+      --range;
+      Assert(row < std::get<1>(*range), dealii::ExcInternalError());
+      return std::get<2>(*range);
+    };
+
+    // One slot per distinct entry, grouped by owner.
+    using Key = std::tuple<unsigned int,
+                           std::uint8_t,
+                           dealii::types::global_dof_index,
+                           dealii::types::global_dof_index>;
+    std::vector<Key> keys;
+    keys.reserve(remote_visits.size());
+    for (const RemoteVisit &visit : remote_visits)
+    {
+      keys.emplace_back(owner_of((visit.code >> 1) & 1, visit.row),
+                        visit.code,
+                        visit.row,
+                        visit.column);
+    }
+    std::vector<Key> slots_by_key = keys;
+    std::sort(slots_by_key.begin(), slots_by_key.end());
+    slots_by_key.erase(std::unique(slots_by_key.begin(), slots_by_key.end()),
+                       slots_by_key.end());
+    remote_slots.resize(keys.size());
+    for (std::size_t v = 0; v < keys.size(); ++v)
+      remote_slots[v] =
+        std::lower_bound(slots_by_key.begin(), slots_by_key.end(), keys[v]) -
+        slots_by_key.begin();
+    remote_visits.clear();
+    remote_visits.shrink_to_fit();
+
+    // Each owner learns once which entries it will receive, in slot order.
+    std::map<unsigned int, std::vector<std::uint64_t>> requests;
+    for (std::size_t k = 0; k < slots_by_key.size(); ++k)
+    {
+      const auto &[owner, code, row, column] = slots_by_key[k];
+      if (send_ranks.empty() || send_ranks.back() != owner)
+      {
+        send_ranks.push_back(owner);
+        send_offsets.push_back(k);
+      }
+      auto &list = requests[owner];
+      list.push_back(code);
+      list.push_back(row);
+      list.push_back(column);
+    }
+    send_offsets.push_back(slots_by_key.size());
+    send_values.assign(slots_by_key.size(), 0.0);
+
+    const auto asked = dealii::Utilities::MPI::some_to_some(comm, requests);
+    for (const auto &[rank, list] : asked)
+    {
+      receive_ranks.push_back(rank);
+      auto &targets = receive_targets.emplace_back();
+      for (std::size_t k = 0; k + 2 < list.size(); k += 3)
+      {
+        const unsigned int b       = (list[k] >> 1) & 1;
+        const unsigned int c       = (list[k] >> 2) & 1;
+        const bool         for_rhs = list[k] & 1;
+        const auto         gid     = [](const std::uint64_t i)
+        { return static_cast<dealii::TrilinosWrappers::types::int_type>(i); };
+        const Epetra_CrsMatrix &m   = matrix.block(b, c).trilinos_matrix();
+        const int               row = m.RowMap().LID(gid(list[k + 1]));
+        if (!ready || row < 0)
+        {
+          ready = false;
+          break;
+        }
+        if (for_rhs)
+        {
+          targets.push_back(vector_values[b] + row);
+          continue;
+        }
+        const int  column = m.ColMap().LID(gid(list[k + 2]));
+        const int *begin  = row_indices[b][c][row];
+        const int *end    = begin + row_lengths[b][c][row];
+        const int *found  = sorted_lower_bound(begin, end, column);
+        if (column < 0 || found == end || *found != column)
+        {
+          ready = false;
+          break;
+        }
+        targets.push_back(row_values[b][c][row] + (found - begin));
+      }
+      receive_values.emplace_back(targets.size());
+    }
+
+    exchange_remote = dealii::Utilities::MPI::min(int(ready), comm) == 1;
+    if (!exchange_remote)
+    {
+      remote_slots.clear();
+      send_ranks.clear();
+      send_offsets.clear();
+      send_values.clear();
+      receive_ranks.clear();
+      receive_targets.clear();
+      receive_values.clear();
+      return;
+    }
+    ignore_non_local_entries(vector);
+  }
+
+
+  template <int dim>
+  void
+  CellScatter<dim>::zero_system(MatrixType &matrix, VectorType &vector) const
+  {
+    vector = 0;
+    if (!exchange_remote)
+    {
+      // deal.II's zeroing compresses each block (an export on several
+      // ranks).
+      matrix = 0;
+      return;
+    }
+    for (unsigned int b = 0; b < 2; ++b)
+      for (unsigned int c = 0; c < 2; ++c)
+        for (std::size_t r = 0; r < row_values[b][c].size(); ++r)
+          std::fill(row_values[b][c][r],
+                    row_values[b][c][r] + row_lengths[b][c][r],
+                    0.0);
+    std::fill(send_values.begin(), send_values.end(), 0.0);
+  }
+
+
+  template <int dim>
+  void
+  CellScatter<dim>::compress_system(MatrixType &matrix,
+                                    VectorType &vector) const
+  {
+    if (!exchange_remote)
+    {
+      matrix.compress(dealii::VectorOperation::add);
+      vector.compress(dealii::VectorOperation::add);
+      return;
+    }
+    // Tag: this exchange's own, apart from the grains' messages.
+    constexpr int            tag  = 7431;
+    const MPI_Comm           comm = matrix.get_mpi_communicator();
+    std::vector<MPI_Request> requests;
+    requests.reserve(receive_ranks.size() + send_ranks.size());
+    for (std::size_t i = 0; i < receive_ranks.size(); ++i)
+      MPI_Irecv(receive_values[i].data(),
+                receive_values[i].size(),
+                MPI_DOUBLE,
+                receive_ranks[i],
+                tag,
+                comm,
+                &requests.emplace_back());
+    for (std::size_t i = 0; i < send_ranks.size(); ++i)
+      MPI_Isend(send_values.data() + send_offsets[i],
+                send_offsets[i + 1] - send_offsets[i],
+                MPI_DOUBLE,
+                send_ranks[i],
+                tag,
+                comm,
+                &requests.emplace_back());
+    MPI_Waitall(requests.size(), requests.data(), MPI_STATUSES_IGNORE);
+    for (std::size_t i = 0; i < receive_ranks.size(); ++i)
+      for (std::size_t k = 0; k < receive_targets[i].size(); ++k)
+        *receive_targets[i][k] += receive_values[i][k];
   }
 
 

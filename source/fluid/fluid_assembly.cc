@@ -635,10 +635,7 @@ namespace ImmersedGrains
            dealii::ExcInternalError());
 
     if (!reactions)
-    {
-      system_matrix = 0;
-      system_rhs    = 0;
-    }
+      cell_scatter->zero_system(system_matrix, system_rhs);
     if (assemble_preconditioner_matrices)
     {
       pressure_mass_matrix = 0;
@@ -886,8 +883,7 @@ namespace ImmersedGrains
         sum = dealii::Utilities::MPI::sum(sum, mpi_communicator);
       return;
     }
-    system_matrix.compress(dealii::VectorOperation::add);
-    system_rhs.compress(dealii::VectorOperation::add);
+    cell_scatter->compress_system(system_matrix, system_rhs);
     drag_averaged_cells =
       dealii::Utilities::MPI::sum(averaged_cells, mpi_communicator);
     if (assemble_preconditioner_matrices)

@@ -351,7 +351,9 @@ namespace ImmersedGrains
                         3)));
     dealii::SolverControl            control(budget, tolerance);
     dealii::SolverFGMRES<VectorType> solver(
-      control, typename dealii::SolverFGMRES<VectorType>::AdditionalData(100));
+      control,
+      krylov_vectors,
+      typename dealii::SolverFGMRES<VectorType>::AdditionalData(100));
     unsigned int failed_iterations = 0;
     try
     {
@@ -436,6 +438,7 @@ namespace ImmersedGrains
         dealii::SolverControl tighter(parameters.max_linear_iterations, target);
         dealii::SolverFGMRES<VectorType> on(
           tighter,
+          krylov_vectors,
           typename dealii::SolverFGMRES<VectorType>::AdditionalData(100));
         try
         {

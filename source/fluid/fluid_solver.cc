@@ -629,6 +629,9 @@ namespace ImmersedGrains
     // Epetra recognises them at once.
     step_iterate.reinit(owned_partitioning, mpi_communicator);
     newton_update.reinit(step_iterate);
+    residual_force.reinit(step_iterate);
+    ignore_non_local_entries(residual_force);
+    krylov_vectors.clear();
     ghost_exchange.reinit(step_iterate, solution);
     cell_scatter = std::make_unique<CellScatter<dim>>();
     cell_scatter->reinit(dof_handler,
@@ -1133,7 +1136,7 @@ namespace ImmersedGrains
     // b = A x + r on the unconstrained rows; a constrained row of the
     // update system holds only its diagonal, and A x there would be the
     // boundary data, not a force.
-    VectorType b(owned_partitioning, mpi_communicator);
+    VectorType &b = residual_force;
     system_matrix.vmult(b, iterate);
     b += system_rhs;
     for (unsigned int block = 0; block < 2; ++block)

@@ -48,6 +48,16 @@ namespace ImmersedGrains
    * buffers by global index, as distribute_local_to_global would, summed
    * on their owner at compress(). Only cells with inhomogeneous
    * constraints keep the general path.
+   *
+   * Where no cell on any rank takes the general path, the other ranks'
+   * rows do not go through deal.II either: each rank sums its entries of
+   * them into one array, sends each owner its part in one message per
+   * assembly (compress_system()), and the owner adds them at positions
+   * found once per mesh. deal.II's compress() of the four blocks and of
+   * the vector, and the compress() in its zeroing of the matrix, each
+   * export through Epetra with collective checks and look-ups of every
+   * entry (a tenth of the 2D cloud's run on two ranks, doc/performance.md
+   * "Two ranks"). The sums are the same as Epetra's.
    */
   template <int dim>
   class CellScatter
@@ -82,6 +92,26 @@ namespace ImmersedGrains
     add(unsigned int                      k,
         const dealii::FullMatrix<double> &cell_matrix,
         const dealii::Vector<double>     &cell_rhs) const;
+
+    /**
+     * Zeroes @p matrix and @p vector, those given to reinit(), for an
+     * assembly, and the sums of other ranks' rows.
+     */
+    void
+    zero_system(MatrixType &matrix, VectorType &vector) const;
+
+    /**
+     * Completes an assembly: adds the entries of rows that other ranks own
+     * on their owners, by the exchange above or by deal.II's compress().
+     * Collective.
+     */
+    void
+    compress_system(MatrixType &matrix, VectorType &vector) const;
+
+    /** Whether the rows that other ranks own go by the exchange above
+     * (the same on every rank). */
+    bool
+    exchanges_remote_rows() const;
 
     /** The direct cells' share of the locally owned cells. */
     double
@@ -150,15 +180,28 @@ namespace ImmersedGrains
     // Per condensed cell and local DoF: its one target if it is free, or -1.
     std::vector<int> condensed_single_targets;
 
+    // Finds the cells' positions (reinit() without the exchange's set-up).
+    void
+    find_positions(const dealii::DoFHandler<dim> &dof_handler,
+                   const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
+                   const dealii::AffineConstraints<double> &constraints,
+                   MatrixType                              &matrix,
+                   VectorType                              &vector);
+
     // Records a cell for the condensed path; false if it does not qualify.
     bool
     add_condensed_cell(
-      const std::vector<dealii::types::global_dof_index>     &dofs,
-      const dealii::AffineConstraints<double>                &constraints,
-      const dealii::Table<2, dealii::DoFTools::Coupling>     &coupling,
-      const MatrixType                                       &matrix,
-      const std::array<std::array<std::vector<int *>, 2>, 2> &row_indices,
-      const std::array<std::array<std::vector<int>, 2>, 2>   &row_lengths);
+      const std::vector<dealii::types::global_dof_index> &dofs,
+      const dealii::AffineConstraints<double>            &constraints,
+      const dealii::Table<2, dealii::DoFTools::Coupling> &coupling,
+      const MatrixType                                   &matrix);
+
+    // Decides with the other ranks whether the exchange below replaces
+    // deal.II's, and finds its slots and targets. Collective.
+    void
+    setup_remote_exchange(const dealii::DoFHandler<dim> &dof_handler,
+                          MatrixType                    &matrix,
+                          VectorType                    &vector);
 
     // Adds a condensed cell's row that another rank owns (Target::row < 0).
     void
@@ -183,8 +226,11 @@ namespace ImmersedGrains
     // Local DoF -> block of its row, and its component.
     std::vector<std::uint8_t>  dof_block;
     std::vector<std::uint16_t> component_of;
-    // The values of each local row of each block, and of each vector block.
+    // The values of each local row of each block, its local column
+    // indices and its length, and the values of each vector block.
     std::array<std::array<std::vector<double *>, 2>, 2> row_values;
+    std::array<std::array<std::vector<int *>, 2>, 2>    row_indices;
+    std::array<std::array<std::vector<int>, 2>, 2>      row_lengths;
     std::array<double *, 2>                             vector_values{};
     // The current cell's rows by local DoF and column block (add()).
     mutable std::vector<double *> row_pointers;
@@ -195,6 +241,29 @@ namespace ImmersedGrains
     mutable std::array<std::vector<dealii::types::global_dof_index>, 2>
                                                remote_columns;
     mutable std::array<std::vector<double>, 2> remote_values;
+
+    // The exchange of other ranks' rows (exchange_remote). An entry of such
+    // a row: its kind (remote_code() in cell_scatter.cc) and block-local
+    // row and column, recorded in the order add_condensed() visits them,
+    // from condensed_remote_start[c] on for condensed cell c; each visit's
+    // slot in send_values, where the slots of one owner are contiguous
+    // (send_offsets, per send_ranks). The owner adds what it receives from
+    // receive_ranks[i] at receive_targets[i].
+    struct RemoteVisit
+    {
+      std::uint8_t                    code;
+      dealii::types::global_dof_index row, column;
+    };
+    bool                                     exchange_remote = false;
+    std::vector<RemoteVisit>                 remote_visits; // reinit() only
+    std::vector<std::size_t>                 condensed_remote_start;
+    std::vector<std::uint32_t>               remote_slots;
+    std::vector<unsigned int>                send_ranks;
+    std::vector<std::size_t>                 send_offsets;
+    mutable std::vector<double>              send_values;
+    std::vector<unsigned int>                receive_ranks;
+    std::vector<std::vector<double *>>       receive_targets;
+    mutable std::vector<std::vector<double>> receive_values;
   };
 } // namespace ImmersedGrains
 

@@ -19,6 +19,7 @@
 #include <immersed_grains/fluid/fluid_parameters.h>
 #include <immersed_grains/fluid/mixture_fields.h>
 #include <immersed_grains/linear_algebra/ghost_exchange.h>
+#include <immersed_grains/linear_algebra/owned_vector_memory.h>
 #include <immersed_grains/mesh/cell_point_shapes.h>
 #include <immersed_grains/mesh/geometry.h>
 
@@ -416,6 +417,10 @@ namespace ImmersedGrains
     // ghosted vectors above.
     VectorType    step_iterate;
     GhostExchange ghost_exchange;
+    // FGMRES's basis vectors, kept between solves; and the vector in which
+    // right_hand_side_norm() forms A x + r.
+    OwnedVectorMemory  krylov_vectors;
+    mutable VectorType residual_force;
 
     // Shape functions at grain positions (point_values); the Q2 ones also at
     // the Gauss points for cell means.
