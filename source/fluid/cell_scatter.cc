@@ -902,22 +902,30 @@ namespace ImmersedGrains
     std::vector<MPI_Request> requests;
     requests.reserve(receive_ranks.size() + send_ranks.size());
     for (std::size_t i = 0; i < receive_ranks.size(); ++i)
-      MPI_Irecv(receive_values[i].data(),
-                receive_values[i].size(),
-                MPI_DOUBLE,
-                receive_ranks[i],
-                tag,
-                comm,
-                &requests.emplace_back());
+    {
+      const int error = MPI_Irecv(receive_values[i].data(),
+                                  receive_values[i].size(),
+                                  MPI_DOUBLE,
+                                  receive_ranks[i],
+                                  tag,
+                                  comm,
+                                  &requests.emplace_back());
+      AssertThrowMPI(error);
+    }
     for (std::size_t i = 0; i < send_ranks.size(); ++i)
-      MPI_Isend(send_values.data() + send_offsets[i],
-                send_offsets[i + 1] - send_offsets[i],
-                MPI_DOUBLE,
-                send_ranks[i],
-                tag,
-                comm,
-                &requests.emplace_back());
-    MPI_Waitall(requests.size(), requests.data(), MPI_STATUSES_IGNORE);
+    {
+      const int error = MPI_Isend(send_values.data() + send_offsets[i],
+                                  send_offsets[i + 1] - send_offsets[i],
+                                  MPI_DOUBLE,
+                                  send_ranks[i],
+                                  tag,
+                                  comm,
+                                  &requests.emplace_back());
+      AssertThrowMPI(error);
+    }
+    const int error =
+      MPI_Waitall(requests.size(), requests.data(), MPI_STATUSES_IGNORE);
+    AssertThrowMPI(error);
     for (std::size_t i = 0; i < receive_ranks.size(); ++i)
       for (std::size_t k = 0; k < receive_targets[i].size(); ++k)
         *receive_targets[i][k] += receive_values[i][k];
