@@ -10,6 +10,7 @@
 #include <immersed_grains/fluid/cell_gather.h>
 #include <immersed_grains/fluid/cell_scatter.h>
 #include <immersed_grains/fluid/fluid_solver.h>
+#include <immersed_grains/linear_algebra/component_block.h>
 
 namespace ImmersedGrains
 {
@@ -884,6 +885,10 @@ namespace ImmersedGrains
       return;
     }
     cell_scatter->compress_system(system_matrix, system_rhs);
+    // The first assembly on a mesh also checks that every component's free
+    // rows hold the same values.
+    if (velocity_block && !velocity_block->update(system_matrix.block(0, 0)))
+      velocity_block.reset();
     drag_averaged_cells =
       dealii::Utilities::MPI::sum(averaged_cells, mpi_communicator);
     if (assemble_preconditioner_matrices)

@@ -247,7 +247,8 @@ namespace ImmersedGrains
                                      nullptr,
       laplace_term ? &schur_diagonal_matrix : nullptr,
       settings,
-      coarse_schur.get());
+      coarse_schur.get(),
+      velocity_block.get());
   }
 
 
@@ -349,7 +350,8 @@ namespace ImmersedGrains
                    3 * (parameters.preconditioner_rebuild_ratio *
                           iterations_after_rebuild +
                         3)));
-    dealii::SolverControl            control(budget, tolerance);
+    const SaddlePointOperator system(system_matrix, velocity_block.get());
+    dealii::SolverControl     control(budget, tolerance);
     dealii::SolverFGMRES<VectorType> solver(
       control,
       krylov_vectors,
@@ -359,7 +361,7 @@ namespace ImmersedGrains
     {
       dealii::TimerOutput::Scope scope(timer, "fluid: solve");
       newton_update = 0;
-      solver.solve(system_matrix, newton_update, system_rhs, *preconditioner);
+      solver.solve(system, newton_update, system_rhs, *preconditioner);
     }
     catch (const dealii::SolverControl::NoConvergence &e)
     {
@@ -408,7 +410,7 @@ namespace ImmersedGrains
       double target = tolerance, reached = tolerance;
       for (unsigned int round = 0; round < 3; ++round)
       {
-        system_matrix.vmult(residual, newton_update);
+        system.vmult(residual, newton_update);
         residual.sadd(-1.0, 1.0, system_rhs);
         preconditioner->vmult(estimate, residual);
         ghost_exchange.to_owned(solution, velocity);
@@ -442,7 +444,7 @@ namespace ImmersedGrains
           typename dealii::SolverFGMRES<VectorType>::AdditionalData(100));
         try
         {
-          on.solve(system_matrix, newton_update, system_rhs, *preconditioner);
+          on.solve(system, newton_update, system_rhs, *preconditioner);
           iterations += tighter.last_step();
           reached = target;
         }

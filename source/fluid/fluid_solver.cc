@@ -641,6 +641,18 @@ namespace ImmersedGrains
                          system_rhs);
     cell_gather = std::make_unique<CellGather<dim>>();
     cell_gather->reinit(dof_handler, solution);
+    {
+      // The velocity block's rows of constrained DoFs hold only their
+      // diagonal; a slip wall constrains only some components of a node.
+      const Epetra_Map &rows =
+        system_matrix.block(0, 0).trilinos_matrix().RowMap();
+      std::vector<bool> fixed(rows.NumMyElements());
+      for (int l = 0; l < rows.NumMyElements(); ++l)
+        fixed[l] = update_constraints.is_constrained(rows.GID(l));
+      velocity_block = std::make_unique<ComponentBlock>();
+      if (!velocity_block->reinit(system_matrix.block(0, 0), dim, fixed))
+        velocity_block.reset();
+    }
 
     {
       // Every pressure DoF's own integral, hanging ones included: the
@@ -1137,7 +1149,7 @@ namespace ImmersedGrains
     // update system holds only its diagonal, and A x there would be the
     // boundary data, not a force.
     VectorType &b = residual_force;
-    system_matrix.vmult(b, iterate);
+    SaddlePointOperator(system_matrix, velocity_block.get()).vmult(b, iterate);
     b += system_rhs;
     for (unsigned int block = 0; block < 2; ++block)
     {

@@ -5,6 +5,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_precondition.h>
 
+#include <immersed_grains/fluid/saddle_point_operator.h>
 #include <immersed_grains/linear_algebra/restricted_schwarz_ilu.h>
 
 #include <vector>
@@ -79,8 +80,11 @@ namespace ImmersedGrains
       const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass,
       const dealii::TrilinosWrappers::SparseMatrix      *pressure_laplace,
       const Settings                                    &settings,
-      const CoarseSchurCorrection                       *coarse = nullptr);
+      const CoarseSchurCorrection                       *coarse = nullptr,
+      const ComponentBlock *velocity_block                      = nullptr);
     // @p coarse, if given, is applied first (CoarseSchurCorrection).
+    // @p velocity_block, if given, is system_matrix's velocity block
+    // stored once for all components: products and the ILU use it.
 
     void
     vmult(VectorType &dst, const VectorType &src) const;
@@ -102,6 +106,7 @@ namespace ImmersedGrains
                         const dealii::TrilinosWrappers::MPI::Vector &src) const;
 
     const dealii::TrilinosWrappers::BlockSparseMatrix &system_matrix;
+    const SaddlePointOperator                          system;
     const Settings                                     settings;
     const dealii::TrilinosWrappers::SparseMatrix      *pressure_mass;
     const CoarseSchurCorrection                       *coarse;

@@ -34,6 +34,7 @@ namespace ImmersedGrains
   class CoarseSchurCorrection;
   template <int dim>
   class CellScatter;
+  class ComponentBlock;
   template <int dim>
   class CellGather;
   template <int dim>
@@ -467,6 +468,11 @@ namespace ImmersedGrains
     std::unique_ptr<CellScatter<dim>> cell_scatter;
     // Each owned cell's DoFs in the ghosted vectors (cell_gather.h).
     std::unique_ptr<CellGather<dim>> cell_gather;
+
+    // The velocity block stored once for its dim components, where it is
+    // K (x) I_dim (component_block.h); null where it is not. Set up with
+    // the matrix, its values copied after each assembly.
+    std::unique_ptr<ComponentBlock> velocity_block;
 
     std::unique_ptr<BlockSchurPreconditioner> preconditioner;
     // Its second level (Linear solver/Coarse correction), once per mesh.

@@ -6,6 +6,8 @@
 
 namespace ImmersedGrains
 {
+  class ComponentBlock;
+
   /**
    * ILU(0) of a distributed matrix, each rank factorising its rows and
    * `overlap` layers of its neighbours' rows, combined as a restricted
@@ -26,6 +28,18 @@ namespace ImmersedGrains
     void
     initialize(const dealii::TrilinosWrappers::SparseMatrix &matrix,
                unsigned int                                  overlap);
+
+    /**
+     * The same for A = K (x) I_n (component_block.h): K's ILU(0), applied
+     * to each of the n components of a vector numbered like A's rows, set
+     * up from a matrix n times smaller and applied reading K's factors once
+     * for all components. Where the components have the same fixed
+     * unknowns that is A's ILU(0) (the components never meet in the
+     * factorisation); where a node is fixed in some components only, K
+     * holds it as free. @p block must outlive this object.
+     */
+    void
+    initialize(const ComponentBlock &block, unsigned int overlap);
   };
 } // namespace ImmersedGrains
 
