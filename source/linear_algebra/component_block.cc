@@ -7,7 +7,6 @@
 #include <Epetra_MultiVector.h>
 
 #include <algorithm>
-#include <map>
 
 namespace ImmersedGrains
 {
@@ -84,8 +83,11 @@ namespace ImmersedGrains
 
     // Each node row of K: for each node column, where in A's values its
     // entry is read (the first free component that has it).
-    const double                   *base = n_rows > 0 ? values_of(a) : nullptr;
-    std::vector<std::map<int, int>> node_rows(alike ? n_rows / n : 0);
+    // (node column, offset in A's values) pairs, sorted by column after
+    // the loop.
+    const double *base = n_rows > 0 ? values_of(a) : nullptr;
+    std::vector<std::vector<std::pair<int, int>>> node_rows(alike ? n_rows / n :
+                                                                    0);
     for (int l = 0; alike && l < n_rows; ++l)
     {
       int     length  = 0;
@@ -105,14 +107,27 @@ namespace ImmersedGrains
       {
         const int column = cols.GID(indices[k]);
         alike            = column % n == c;
-        row.emplace(column / n, (values + k) - base);
+        row.emplace_back(column / n, (values + k) - base);
       }
+    }
+    // One entry per column: the first component's that has it.
+    for (auto &row : node_rows)
+    {
+      std::stable_sort(row.begin(),
+                       row.end(),
+                       [](const auto &x, const auto &y)
+                       { return x.first < y.first; });
+      row.erase(std::unique(row.begin(),
+                            row.end(),
+                            [](const auto &x, const auto &y)
+                            { return x.first == y.first; }),
+                row.end());
     }
     // A node fixed in every component keeps its diagonal (of the first).
     for (std::size_t f = 0; alike && f < fixed_rows.size(); ++f)
       if (fixed_rows[f] % n == 0 && node_rows[fixed_rows[f] / n].empty())
-        node_rows[fixed_rows[f] / n].emplace(rows.GID(fixed_rows[f]) / n,
-                                             fixed_diagonal[f]);
+        node_rows[fixed_rows[f] / n].emplace_back(rows.GID(fixed_rows[f]) / n,
+                                                  fixed_diagonal[f]);
     if (!all_ranks(alike, a.Comm()))
       return false;
 
@@ -161,8 +176,22 @@ namespace ImmersedGrains
       double *values    = nullptr;
       int    *k_indices = nullptr;
       matrix->ExtractMyRowView(i, length, values, k_indices);
+      // update() finds A's entries in K's rows by bisection.
+      AssertThrow(std::is_sorted(k_indices, k_indices + length),
+                  dealii::ExcMessage("Epetra left a row of K unsorted"));
+      const auto &row = node_rows[i];
       for (int k = 0; k < length; ++k)
-        source.push_back(node_rows[i].at(node_column_map->GID(k_indices[k])));
+      {
+        const int  column = node_column_map->GID(k_indices[k]);
+        const auto at     = std::lower_bound(row.begin(),
+                                         row.end(),
+                                         column,
+                                         [](const auto &entry, const int c)
+                                         { return entry.first < c; });
+        Assert(at != row.end() && at->first == column,
+               dealii::ExcInternalError());
+        source.push_back(at->second);
+      }
     }
     fixed_values.resize(fixed_rows.size());
     components        = n;
@@ -189,11 +218,15 @@ namespace ImmersedGrains
     if (values_checked)
       return true;
 
-    // Every free row's entries against K's.
+    // Every free row's entries against K's, A's columns translated to K's
+    // once.
     values_checked         = true;
-    bool        alike      = true;
-    const int   n          = components;
-    const auto &cols       = a.ColMap();
+    bool             alike = true;
+    const int        n     = components;
+    const auto      &cols  = a.ColMap();
+    std::vector<int> k_column(cols.NumMyElements());
+    for (int k = 0; k < cols.NumMyElements(); ++k)
+      k_column[k] = node_column_map->LID(cols.GID(k) / n);
     std::size_t next_fixed = 0;
     for (int l = 0; l < a.NumMyRows() && alike; ++l)
     {
@@ -209,10 +242,11 @@ namespace ImmersedGrains
       matrix->ExtractMyRowView(l / n, k_length, k_values, k_indices);
       for (int k = 0; k < length && alike; ++k)
       {
-        const int  column = node_column_map->LID(cols.GID(indices[k]) / n);
-        const int *at     = std::find(k_indices, k_indices + k_length, column);
-        alike =
-          at != k_indices + k_length && k_values[at - k_indices] == values[k];
+        const int *at = std::lower_bound(k_indices,
+                                         k_indices + k_length,
+                                         k_column[indices[k]]);
+        alike = at != k_indices + k_length && *at == k_column[indices[k]] &&
+                k_values[at - k_indices] == values[k];
       }
     }
     return all_ranks(alike, a.Comm());
@@ -242,20 +276,25 @@ namespace ImmersedGrains
                              Epetra_MultiVector       &interleaved,
                              const bool                inverse_diagonal) const
   {
+    // The fixed values first: @p fixed_source may be @p interleaved.
+    const double *x = fixed_source[0];
+    fixed_results.resize(fixed_rows.size());
+    for (std::size_t f = 0; f < fixed_rows.size(); ++f)
+    {
+      const int l = fixed_rows[f];
+      fixed_results[f] =
+        inverse_diagonal ? x[l] / fixed_values[f] : fixed_values[f] * x[l];
+    }
     double   *y = interleaved[0];
     const int n = components;
     for (int c = 0; c < n; ++c)
     {
-      const double *x = split[c];
+      const double *z = split[c];
       for (int i = 0; i < split.MyLength(); ++i)
-        y[n * i + c] = x[i];
+        y[n * i + c] = z[i];
     }
-    const double *x = fixed_source[0];
     for (std::size_t f = 0; f < fixed_rows.size(); ++f)
-    {
-      const int l = fixed_rows[f];
-      y[l] = inverse_diagonal ? x[l] / fixed_values[f] : fixed_values[f] * x[l];
-    }
+      y[fixed_rows[f]] = fixed_results[f];
   }
 
 

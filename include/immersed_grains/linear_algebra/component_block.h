@@ -114,8 +114,9 @@ namespace ImmersedGrains
     std::vector<int> source;
     // A's fixed rows (local order), where their diagonal is in A's values,
     // and its value at the last update().
-    std::vector<int>    fixed_rows, fixed_diagonal;
-    std::vector<double> fixed_values;
+    std::vector<int>            fixed_rows, fixed_diagonal;
+    std::vector<double>         fixed_values;
+    mutable std::vector<double> fixed_results;
 
     // The split copies of a product's source and destination.
     mutable std::unique_ptr<Epetra_MultiVector> split_source, split_destination;
