@@ -81,10 +81,8 @@ namespace ImmersedGrains
         node_gids.push_back(first / n);
     }
 
-    // Each node row of K: for each node column, where in A's values its
-    // entry is read (the first free component that has it).
-    // (node column, offset in A's values) pairs, sorted by column after
-    // the loop.
+    // Each node row of K as (node column, offset in A's values) pairs: the
+    // entry is read from the first free component that has it.
     const double *base = n_rows > 0 ? values_of(a) : nullptr;
     std::vector<std::vector<std::pair<int, int>>> node_rows(alike ? n_rows / n :
                                                                     0);
