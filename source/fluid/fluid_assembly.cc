@@ -563,7 +563,11 @@ namespace ImmersedGrains
                      dealii::Vector<double>     &cell_rhs)
     {
       const unsigned int n_s = integrals.n_s, n_p = integrals.n_p;
-      cell_matrix = 0;
+      // Without Newton's derivative the loops below overwrite every entry
+      // that is not zero on every cell (a velocity couples only with its
+      // own component), so the rest keeps the zeros it was made with.
+      if (convection_derivative)
+        cell_matrix = 0;
       for (unsigned int c = 0; c < dim; ++c)
         for (unsigned int a = 0; a < n_s; ++a)
         {

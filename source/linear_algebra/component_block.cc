@@ -300,14 +300,19 @@ namespace ImmersedGrains
   ComponentBlock::vmult(dealii::TrilinosWrappers::MPI::Vector       &dst,
                         const dealii::TrilinosWrappers::MPI::Vector &src) const
   {
-    split(src.trilinos_vector(), *split_source);
+    vmult(dst.trilinos_vector(), src.trilinos_vector());
+  }
+
+
+  void
+  ComponentBlock::vmult(Epetra_MultiVector       &dst,
+                        const Epetra_MultiVector &src) const
+  {
+    split(src, *split_source);
     const int error =
       matrix->Multiply(false, *split_source, *split_destination);
     AssertThrow(error == 0, dealii::ExcMessage("Epetra: Multiply"));
-    interleave(*split_destination,
-               src.trilinos_vector(),
-               dst.trilinos_vector(),
-               false);
+    interleave(*split_destination, src, dst, false);
   }
 
 

@@ -6,6 +6,7 @@
 #include <deal.II/lac/trilinos_precondition.h>
 
 #include <immersed_grains/fluid/saddle_point_operator.h>
+#include <immersed_grains/linear_algebra/component_smoothed_amg.h>
 #include <immersed_grains/linear_algebra/restricted_schwarz_ilu.h>
 
 #include <vector>
@@ -115,7 +116,7 @@ namespace ImmersedGrains
     const dealii::TrilinosWrappers::PreconditionBase &
     velocity_preconditioner() const;
 
-    dealii::TrilinosWrappers::PreconditionAMG velocity_amg;
+    ComponentSmoothedAMG                      velocity_amg;
     RestrictedSchwarzILU                      velocity_ilu;
     dealii::TrilinosWrappers::PreconditionILU pressure_mass_ilu;
     dealii::TrilinosWrappers::PreconditionAMG pressure_laplace_amg;

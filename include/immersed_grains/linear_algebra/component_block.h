@@ -70,6 +70,10 @@ namespace ImmersedGrains
     vmult(dealii::TrilinosWrappers::MPI::Vector       &dst,
           const dealii::TrilinosWrappers::MPI::Vector &src) const;
 
+    /** The same on Epetra vectors numbered like A's rows (one column). */
+    void
+    vmult(Epetra_MultiVector &dst, const Epetra_MultiVector &src) const;
+
     /** K, whose rows are the nodes this rank owns. */
     const Epetra_CrsMatrix &
     scalar_matrix() const;
