@@ -23,8 +23,10 @@ namespace ImmersedGrains
    * n times larger than K, and on several ranks first imports the
    * overlapping rows of A. K's ILU is A's where the components have the
    * same fixed unknowns (the components never meet in the factorisation),
-   * so on one rank the V-cycle is the same; its residuals are K's products.
-   * The coarser levels are ML's, built from A as before: an AMG of K
+   * and ML's overlapping ILU, like RestrictedSchwarzILU, keeps each rank's
+   * own rows of its subdomain's solution: the V-cycle is the same to
+   * round-off, on one rank and on several. Its residuals are K's products.
+   * The coarser levels are ML's, built from A: an AMG of K
    * applied to each component took longer to apply (ML applies a
    * multi-vector one column at a time).
    *
