@@ -58,6 +58,7 @@ namespace ImmersedGrains
     fixed_diagonal.clear();
     fixed_values.clear();
     values_checked = false;
+    fixed_alike    = false;
     components     = 0;
 
     const Epetra_CrsMatrix &a      = A.trilinos_matrix();
@@ -128,6 +129,10 @@ namespace ImmersedGrains
                                                   fixed_diagonal[f]);
     if (!all_ranks(alike, a.Comm()))
       return false;
+    bool same_fixed = true;
+    for (int l = 0; l < n_rows && same_fixed; ++l)
+      same_fixed = fixed[l] == fixed[l - l % n];
+    fixed_alike = all_ranks(same_fixed, a.Comm());
 
     // K's columns: the owned nodes first, in order, then the others.
     const Epetra_Comm &comm = a.Comm();
@@ -320,6 +325,13 @@ namespace ImmersedGrains
   ComponentBlock::scalar_matrix() const
   {
     return *matrix;
+  }
+
+
+  bool
+  ComponentBlock::components_fixed_alike() const
+  {
+    return fixed_alike;
   }
 
 

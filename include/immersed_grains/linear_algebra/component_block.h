@@ -81,6 +81,13 @@ namespace ImmersedGrains
     unsigned int
     n_components() const;
 
+    /**
+     * Whether every node is fixed in all its components or in none (no
+     * slip wall): then K's ILU(0) is A's. Collective at reinit().
+     */
+    bool
+    components_fixed_alike() const;
+
     /** The rows of A (its range map), for operators that stand for A. */
     const Epetra_Map &
     component_map() const;
@@ -112,6 +119,7 @@ namespace ImmersedGrains
     std::unique_ptr<Epetra_Map>       row_map;
     std::unique_ptr<Epetra_CrsMatrix> matrix;
     bool                              values_checked = false;
+    bool                              fixed_alike    = false;
 
     // Where each of K's entries (in its storage order) is read in A's
     // values, and the A rows whose free entries update() checks once.

@@ -46,7 +46,8 @@ namespace ImmersedGrains
      * The AMG of @p matrix with ML's @p parameters on every level but the
      * finest, which takes @p block's ILU with @p overlap layers of the
      * neighbouring ranks' rows. @p block stands for @p matrix and must
-     * outlive this object.
+     * outlive this object. Where @p block's components do not share their
+     * fixed unknowns (a slip wall), ML's own smoother stays.
      */
     void
     initialize(const dealii::TrilinosWrappers::SparseMatrix &matrix,
@@ -61,6 +62,10 @@ namespace ImmersedGrains
      */
     void
     smooth(double *x, const double *rhs, bool zero_guess) const;
+
+    /** Whether the finest level is smoothed by K's ILU. */
+    bool
+    smooths_through_components() const;
 
   private:
     const ComponentBlock                  *block = nullptr;
