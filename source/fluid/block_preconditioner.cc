@@ -75,7 +75,7 @@ namespace ImmersedGrains
       // The finest level's smoother through K where there is one
       // (component_smoothed_amg.h): the 3D cloud's first 0.03 s on two
       // ranks took 2.2 s of preconditioner builds instead of 4.1 s and
-      // 2.2 s of solves instead of 2.8 s, at the same iterations.
+      // 2.2 s of solves instead of 2.8 s, with the same V-cycle.
       if (velocity_block != nullptr)
         velocity_amg.initialize(system_matrix.block(0, 0),
                                 *velocity_block,
