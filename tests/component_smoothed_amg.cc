@@ -13,8 +13,8 @@
 // ranks (.mpirun=2). K's ILU(0) is A's, the components never meeting in
 // the factorisation; the residual comes from K's product, the same sums as
 // A's; and ML's overlapping ILU, like RestrictedSchwarzILU, keeps each
-// rank's own rows of its subdomain's solution. Without the finest
-// smoother installed the V-cycles differ by order one.
+// rank's own rows of its subdomain's solution. With the finest smoother
+// not installed the no-slip lines read NO.
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/trilinos_precondition.h>
