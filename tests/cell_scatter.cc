@@ -7,10 +7,13 @@
 // (the component coupling of the fluid solver; a zero pressure diagonal in
 // some cells, where a constrained row takes the mean diagonal) and must
 // agree to round-off; serial and in parallel (.mpirun=2, where cells that
-// write other ranks' rows send those rows' sums to their owner in one
-// message). With a wall that moves (inhomogeneous constraints) the cells
-// on it take deal.II's path, and on two ranks the other ranks' rows then
-// go through deal.II's non-local buffers and compress() as well.
+// write other ranks' rows, added entry by entry or condensed, send those
+// rows' sums to their owner in one message; with the sums of the cells
+// added entry by entry left out, the matrix lines read NO). With a wall
+// that moves (inhomogeneous constraints) the cells on it take deal.II's
+// path, and on two ranks the cells that write other ranks' rows are
+// condensed, those rows going through deal.II's non-local buffers and
+// compress().
 #include <deal.II/base/function.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/distributed/tria.h>

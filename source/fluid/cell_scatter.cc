@@ -71,6 +71,7 @@ namespace ImmersedGrains
   {
     pairs.clear();
     direct_index.clear();
+    direct_remote_start.clear();
     condensed_index.clear();
     condensed_targets_start.clear();
     condensed_entries_start.clear();
@@ -100,7 +101,8 @@ namespace ImmersedGrains
     condensed_remote_start.clear();
     remote_visits.clear();
     remote_slots.clear();
-    exchange_remote = false;
+    exchange_remote         = false;
+    remote_rows_by_exchange = false;
     send_ranks.clear();
     send_offsets.clear();
     send_values.clear();
@@ -154,6 +156,17 @@ namespace ImmersedGrains
     clear();
     system_matrix = &matrix;
     system_vector = &vector;
+    // On several ranks a cell next to another rank's cells writes rows that
+    // rank owns: they go by the exchange (setup_remote_exchange()), which
+    // needs every cell on every rank to take the direct or condensed path.
+    // Cells with inhomogeneous constraints take the general path, so then
+    // such cells are condensed instead (their other rows then go by global
+    // index).
+    const MPI_Comm comm = matrix.get_mpi_communicator();
+    remote_rows_by_exchange =
+      dealii::Utilities::MPI::n_mpi_processes(comm) > 1 &&
+      dealii::Utilities::MPI::min(constraints.has_inhomogeneities() ? 0 : 1,
+                                  comm) == 1;
     find_positions(dof_handler, coupling, constraints, matrix, vector);
     // Every rank, whatever find_positions() found: collective.
     setup_remote_exchange(dof_handler, matrix, vector);
@@ -240,20 +253,23 @@ namespace ImmersedGrains
     std::array<std::vector<int>, 2> cell_columns;
     for (auto &columns : cell_columns)
       columns.resize(dofs_per_cell);
-    std::vector<std::uint16_t> cell_positions(pairs.size());
+    std::vector<std::uint16_t>                   cell_positions(pairs.size());
+    std::vector<dealii::types::global_dof_index> cell_indices(dofs_per_cell);
     for (const auto &cell : dof_handler.active_cell_iterators())
     {
       if (!cell->is_locally_owned())
         continue;
       cell->get_dof_indices(dofs);
-      bool direct = true;
+      bool direct = true, remote = false;
       for (unsigned int i = 0; i < dofs_per_cell && direct; ++i)
       {
         const auto [block, index] = blocks.global_to_local(dofs[i]);
+        cell_indices[i]           = index;
         const Epetra_CrsMatrix &m =
           matrix.block(block, block).trilinos_matrix();
         cell_rows[i] = m.RowMap().LID(
           static_cast<dealii::TrilinosWrappers::types::int_type>(index));
+        remote = remote || cell_rows[i] < 0;
         for (unsigned int row_block = 0; row_block < 2; ++row_block)
           cell_columns[row_block][i] =
             matrix.block(row_block, block)
@@ -262,7 +278,8 @@ namespace ImmersedGrains
               .LID(
                 static_cast<dealii::TrilinosWrappers::types::int_type>(index));
         cell_fixed[i] = constraints.is_constrained(dofs[i]);
-        direct        = block == dof_block[i] && cell_rows[i] >= 0 &&
+        direct        = block == dof_block[i] &&
+                 (cell_rows[i] >= 0 || remote_rows_by_exchange) &&
                  (!cell_fixed[i] ||
                   (constraints.get_constraint_entries(dofs[i])->empty() &&
                    !constraints.is_inhomogeneously_constrained(dofs[i])));
@@ -273,6 +290,12 @@ namespace ImmersedGrains
         if ((cell_fixed[pair.i] || cell_fixed[pair.j]) && pair.i != pair.j)
         {
           cell_positions[p] = skip;
+          continue;
+        }
+        // Another rank's row: a slot of the exchange, not a position.
+        if (cell_rows[pair.i] < 0)
+        {
+          cell_positions[p] = 0;
           continue;
         }
         const int  column = cell_columns[pair.row_block][pair.j];
@@ -289,6 +312,23 @@ namespace ImmersedGrains
       if (direct)
       {
         direct_index.push_back(rows.size() / dofs_per_cell);
+        // The entries of other ranks' rows in the order add() visits them:
+        // the pairs of such rows, then their right-hand sides.
+        direct_remote_start.push_back(remote ? remote_visits.size() :
+                                               no_remote);
+        if (remote)
+        {
+          for (std::size_t p = 0; p < pairs.size(); ++p)
+            if (cell_positions[p] != skip && cell_rows[pairs[p].i] < 0)
+              remote_visits.push_back(
+                {remote_code(false, pairs[p].row_block, pairs[p].column_block),
+                 cell_indices[pairs[p].i],
+                 cell_indices[pairs[p].j]});
+          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+            if (!cell_fixed[i] && cell_rows[i] < 0)
+              remote_visits.push_back(
+                {remote_code(true, dof_block[i], 0), cell_indices[i], 0});
+        }
         rows.insert(rows.end(), cell_rows.begin(), cell_rows.end());
         fixed.insert(fixed.end(), cell_fixed.begin(), cell_fixed.end());
         positions.insert(positions.end(),
@@ -542,8 +582,30 @@ namespace ImmersedGrains
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       for (unsigned int column_block = 0; column_block < 2; ++column_block)
         row_pointers[2 * i + column_block] =
-          row_values[dof_block[i]][column_block][cell_rows[i]];
+          cell_rows[i] < 0 ?
+            nullptr :
+            row_values[dof_block[i]][column_block][cell_rows[i]];
 
+    if (direct_remote_start[d] == no_remote)
+    {
+      for (std::size_t p = 0; p < pairs.size(); ++p)
+      {
+        if (cell_slots[p] == skip)
+          continue;
+        const Pair &pair  = pairs[p];
+        double      value = cell_matrix(pair.i, pair.j);
+        if (pair.i == pair.j && fixed[first_dof + pair.i])
+          value = value != 0 ? std::abs(value) : mean_diagonal;
+        row_pointers[2 * pair.i + pair.column_block][cell_slots[p]] += value;
+      }
+      for (unsigned int i = 0; i < dofs_per_cell; ++i)
+        if (!fixed[first_dof + i])
+          vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
+      return;
+    }
+
+    // Rows that another rank owns: summed in their slots of the exchange.
+    const std::uint32_t *slot = remote_slots.data() + direct_remote_start[d];
     for (std::size_t p = 0; p < pairs.size(); ++p)
     {
       if (cell_slots[p] == skip)
@@ -552,11 +614,19 @@ namespace ImmersedGrains
       double      value = cell_matrix(pair.i, pair.j);
       if (pair.i == pair.j && fixed[first_dof + pair.i])
         value = value != 0 ? std::abs(value) : mean_diagonal;
-      row_pointers[2 * pair.i + pair.column_block][cell_slots[p]] += value;
+      if (cell_rows[pair.i] < 0)
+        send_values[*slot++] += value;
+      else
+        row_pointers[2 * pair.i + pair.column_block][cell_slots[p]] += value;
     }
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       if (!fixed[first_dof + i])
-        vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
+      {
+        if (cell_rows[i] < 0)
+          send_values[*slot++] += cell_rhs(i);
+        else
+          vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
+      }
   }
 
 
@@ -770,24 +840,30 @@ namespace ImmersedGrains
                            std::uint8_t,
                            dealii::types::global_dof_index,
                            dealii::types::global_dof_index>;
-    std::vector<Key> keys;
-    keys.reserve(remote_visits.size());
-    for (const RemoteVisit &visit : remote_visits)
+    // The visits sorted by key with their numbers: each run of equal keys
+    // is one slot.
+    std::vector<std::pair<Key, std::uint32_t>> keyed;
+    keyed.reserve(remote_visits.size());
+    for (std::size_t v = 0; v < remote_visits.size(); ++v)
     {
-      keys.emplace_back(owner_of((visit.code >> 1) & 1, visit.row),
-                        visit.code,
-                        visit.row,
-                        visit.column);
+      const RemoteVisit &visit = remote_visits[v];
+      keyed.emplace_back(Key(owner_of((visit.code >> 1) & 1, visit.row),
+                             visit.code,
+                             visit.row,
+                             visit.column),
+                         static_cast<std::uint32_t>(v));
     }
-    std::vector<Key> slots_by_key = keys;
-    std::sort(slots_by_key.begin(), slots_by_key.end());
-    slots_by_key.erase(std::unique(slots_by_key.begin(), slots_by_key.end()),
-                       slots_by_key.end());
-    remote_slots.resize(keys.size());
-    for (std::size_t v = 0; v < keys.size(); ++v)
-      remote_slots[v] =
-        std::lower_bound(slots_by_key.begin(), slots_by_key.end(), keys[v]) -
-        slots_by_key.begin();
+    std::sort(keyed.begin(), keyed.end());
+    std::vector<Key> slots_by_key;
+    remote_slots.resize(keyed.size());
+    for (const auto &[key, v] : keyed)
+    {
+      if (slots_by_key.empty() || slots_by_key.back() != key)
+        slots_by_key.push_back(key);
+      remote_slots[v] = slots_by_key.size() - 1;
+    }
+    keyed.clear();
+    keyed.shrink_to_fit();
     remote_visits.clear();
     remote_visits.shrink_to_fit();
 
@@ -850,6 +926,12 @@ namespace ImmersedGrains
     exchange_remote = dealii::Utilities::MPI::min(int(ready), comm) == 1;
     if (!exchange_remote)
     {
+      // Not reached where no constraint is inhomogeneous, unless a
+      // condensed cell failed to qualify; the direct cells that write other
+      // ranks' rows then take the general path.
+      for (int &d : direct_index)
+        if (d >= 0 && direct_remote_start[d] != no_remote)
+          d = -1;
       remote_slots.clear();
       send_ranks.clear();
       send_offsets.clear();

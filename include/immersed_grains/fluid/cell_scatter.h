@@ -24,9 +24,10 @@ namespace ImmersedGrains
    * (a binary search and a map from global to local column) at every
    * assembly: half of the cell loop's time in 3D (doc/performance.md).
    *
-   * A cell qualifies when all its DoFs are owned by this rank and each is
-   * either free or fixed to zero by a constraint without entries (walls,
-   * slip on faces normal to an axis): there distribute_local_to_global
+   * A cell qualifies when all its DoFs are owned by this rank (on several
+   * ranks, see below) and each is either free or fixed to zero by a
+   * constraint without entries (walls, slip on faces normal to an axis):
+   * there distribute_local_to_global
    * adds the free rows' entries in free columns, the absolute diagonal
    * entry (or the mean absolute diagonal where it is zero) on each fixed
    * row, and nothing else, which add() repeats entry by entry in the same
@@ -42,20 +43,25 @@ namespace ImmersedGrains
    * distribute_local_to_global's, in another order (round-off).
    *
    * On several ranks a cell next to another rank's cells writes rows that
-   * rank owns (a quarter of the cells of a 3D cloud on two ranks). Such a
-   * cell takes the condensed path too: its owned rows at their positions,
-   * the other rank's rows through the matrix's and vector's non-local
-   * buffers by global index, as distribute_local_to_global would, summed
-   * on their owner at compress(). Only cells with inhomogeneous
-   * constraints keep the general path.
+   * rank owns (a quarter of the cells of a 3D cloud on two ranks, all on
+   * the higher rank: deal.II gives a DoF on the rank boundary to the lower
+   * one). Such a cell takes the direct or the condensed path as above for
+   * its owned rows, and the other rank's rows go by the exchange below.
+   * Where some constraint is inhomogeneous the exchange is not used: such
+   * a cell is then condensed, and the other rank's rows go through the
+   * matrix's and vector's non-local buffers by global index, as
+   * distribute_local_to_global would, summed on their owner at
+   * compress(). Only cells with inhomogeneous constraints keep the
+   * general path.
    *
    * Where no cell on any rank takes the general path, the other ranks'
    * rows do not go through deal.II either: each rank sums its entries of
-   * them into one array, sends each owner its part in one message per
-   * assembly (compress_system()), and the owner adds them at positions
-   * found once per mesh. deal.II's compress() of the four blocks and of
-   * the vector, and the compress() in its zeroing of the matrix, each
-   * export through Epetra with collective checks and look-ups of every
+   * them into one array (a slot per entry, found once per mesh, which
+   * the cells' visits add to in their order), sends each owner its part
+   * in one message per assembly (compress_system()), and the owner adds
+   * them at positions found once per mesh. deal.II's compress() of the four
+   * blocks and of the vector, and the compress() in its zeroing of the matrix,
+   * each export through Epetra with collective checks and look-ups of every
    * entry (a tenth of the 2D cloud's run on two ranks, doc/performance.md
    * "Two ranks"). The sums are the same as Epetra's.
    */
@@ -132,6 +138,12 @@ namespace ImmersedGrains
 
     // Per locally owned cell: its number among the direct cells, or -1.
     std::vector<int> direct_index;
+    // Per direct cell: where its entries of other ranks' rows start in
+    // remote_slots, or no_remote.
+    static constexpr std::size_t no_remote = std::size_t(-1);
+    // Whether direct cells may write other ranks' rows (reinit()).
+    bool                     remote_rows_by_exchange = false;
+    std::vector<std::size_t> direct_remote_start;
     // Per locally owned cell: its number among the condensed cells, or -1.
     std::vector<int> condensed_index;
 
