@@ -4,8 +4,9 @@
 // velocity, constraints without entries): the cells with hanging or
 // periodic DoFs are condensed in the cell, the others added entry by entry.
 // Both systems are assembled from the same pseudo-random cell matrices
-// (the component coupling of the fluid solver; a zero pressure diagonal in
-// some cells, where a constrained row takes the mean diagonal) and must
+// (the component coupling of the fluid solver; zero diagonals in some
+// cells, where a constrained row takes the mean diagonal or the l1 norm,
+// and zero matrices in some) and must
 // agree to round-off; serial and in parallel (.mpirun=2, where cells that
 // write other ranks' rows, added entry by entry or condensed, send those
 // rows' sums to their owner in one message; with the sums of the cells
@@ -139,9 +140,17 @@ check(const bool moving_wall)
           cell_matrix(i, j) =
             std::sin(1 + 0.37 * i + 0.11 * j + 3.1 * x[0] + 1.7 * x[1]);
         }
-        // A zero pressure diagonal in every third cell.
-        cell_matrix(i, i) = (ci == dim && k % 3 == 0) ? 0.0 : 4 + i % 5;
+        // A zero pressure diagonal in every third cell, a zero velocity
+        // diagonal in every fifth (a fixed row then takes the mean
+        // absolute diagonal), a zero diagonal in every seventh (the l1
+        // norm), and a zero matrix in every eleventh (then 1).
+        cell_matrix(i, i) = ((ci == dim && k % 3 == 0) ||
+                             (ci < dim && k % 5 == 4) || k % 7 == 1) ?
+                              0.0 :
+                              4 + i % 5;
       }
+      if (k % 11 == 2)
+        cell_matrix = 0;
       bool has_entries = false;
       for (const auto dof : dofs)
         has_entries =
