@@ -256,7 +256,7 @@ namespace ImmersedGrains
     std::vector<std::uint16_t>                   cell_positions(pairs.size());
     std::vector<dealii::types::global_dof_index> cell_indices(dofs_per_cell);
     // The direct cells' arrays at their largest, instead of copies as they
-    // grow (a few per cent of a set-up).
+    // grow (2 % of the 3D cloud's set-up).
     std::size_t n_owned = 0;
     for (const auto &cell : dof_handler.active_cell_iterators())
       n_owned += cell->is_locally_owned() ? 1 : 0;

@@ -27,11 +27,11 @@ namespace ImmersedGrains
    * A cell qualifies when all its DoFs are owned by this rank (on several
    * ranks, see below) and each is either free or fixed to zero by a
    * constraint without entries (walls, slip on faces normal to an axis):
-   * there distribute_local_to_global
-   * adds the free rows' entries in free columns, the absolute diagonal
-   * entry (or the mean absolute diagonal where it is zero) on each fixed
-   * row, and nothing else, which add() repeats entry by entry in the same
-   * order, so that the assembled system is the same to the last bit.
+   * there distribute_local_to_global adds the free rows' entries in free
+   * columns, the absolute diagonal entry (or the mean absolute diagonal
+   * where it is zero) on each fixed row, and nothing else, which add()
+   * repeats entry by entry in the same order, so that the assembled system
+   * is the same to the last bit.
    *
    * A cell with hanging-node or periodic constraints qualifies too when
    * every row it writes (its free DoFs, the masters of its constrained
