@@ -598,26 +598,11 @@ namespace ImmersedGrains
             nullptr :
             row_values[dof_block[i]][column_block][cell_rows[i]];
 
-    if (direct_remote_start[d] == no_remote)
-    {
-      for (std::size_t p = 0; p < pairs.size(); ++p)
-      {
-        if (cell_slots[p] == skip)
-          continue;
-        const Pair &pair  = pairs[p];
-        double      value = cell_matrix(pair.i, pair.j);
-        if (pair.i == pair.j && fixed[first_dof + pair.i])
-          value = value != 0 ? std::abs(value) : mean_diagonal;
-        row_pointers[2 * pair.i + pair.column_block][cell_slots[p]] += value;
-      }
-      for (unsigned int i = 0; i < dofs_per_cell; ++i)
-        if (!fixed[first_dof + i])
-          vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
-      return;
-    }
-
-    // Rows that another rank owns: summed in their slots of the exchange.
-    const std::uint32_t *slot = remote_slots.data() + direct_remote_start[d];
+    // Rows that another rank owns are summed in their slots of the
+    // exchange.
+    const std::uint32_t *slot = direct_remote_start[d] == no_remote ?
+                                  nullptr :
+                                  remote_slots.data() + direct_remote_start[d];
     for (std::size_t p = 0; p < pairs.size(); ++p)
     {
       if (cell_slots[p] == skip)
@@ -626,7 +611,7 @@ namespace ImmersedGrains
       double      value = cell_matrix(pair.i, pair.j);
       if (pair.i == pair.j && fixed[first_dof + pair.i])
         value = value != 0 ? std::abs(value) : mean_diagonal;
-      if (cell_rows[pair.i] < 0)
+      if (slot != nullptr && cell_rows[pair.i] < 0)
         send_values[*slot++] += value;
       else
         row_pointers[2 * pair.i + pair.column_block][cell_slots[p]] += value;
@@ -634,7 +619,7 @@ namespace ImmersedGrains
     for (unsigned int i = 0; i < dofs_per_cell; ++i)
       if (!fixed[first_dof + i])
       {
-        if (cell_rows[i] < 0)
+        if (slot != nullptr && cell_rows[i] < 0)
           send_values[*slot++] += cell_rhs(i);
         else
           vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
