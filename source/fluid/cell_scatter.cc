@@ -923,9 +923,9 @@ namespace ImmersedGrains
     exchange_remote = dealii::Utilities::MPI::min(int(ready), comm) == 1;
     if (!exchange_remote)
     {
-      // Not reached where no constraint is inhomogeneous, unless a
-      // condensed cell failed to qualify; the direct cells that write other
-      // ranks' rows then take the general path.
+      // Not reached where no constraint is inhomogeneous, unless a cell or
+      // an owner's look-up of a slot failed to qualify; the direct cells
+      // that write other ranks' rows then take the general path.
       for (int &d : direct_index)
         if (d >= 0 && direct_remote_start[d] != no_remote)
           d = -1;
