@@ -2,11 +2,18 @@
 #define immersed_grains_mesh_cell_point_shapes_h
 
 #include <deal.II/base/point.h>
+#include <deal.II/base/polynomial.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/fe/fe.h>
 #include <deal.II/grid/tria.h>
 
 #include <vector>
+
+namespace dealii
+{
+  template <int dim, int spacedim>
+  class FE_Poly;
+}
 
 namespace ImmersedGrains
 {
@@ -69,13 +76,34 @@ namespace ImmersedGrains
                 const unsigned int         q) const;
 
   private:
-    const dealii::FiniteElement<dim>   &fe;
-    const unsigned int                  n_dofs;
-    std::vector<dealii::Point<dim>>     points;
-    std::vector<double>                 values;
-    std::vector<dealii::Tensor<1, dim>> reference_gradients;
-    std::vector<dealii::Tensor<1, dim>> gradients;
-    std::vector<double>                 determinants;
+    /** Values (and gradients if @p with_gradients) at the reference points. */
+    void
+    evaluate_reference(bool with_gradients);
+
+    /** The same at point @p q for a tensor-product element. */
+    void
+    evaluate_tensor_product(unsigned int q, bool with_gradients);
+
+    const dealii::FiniteElement<dim> &fe;
+    const dealii::FE_Poly<dim, dim>  *polynomial_fe;
+    const unsigned int                n_dofs;
+    bool                              have_reference_gradients = false;
+    // A tensor-product element's 1D polynomials and the map from the
+    // lexicographic numbering to the element's (empty for other elements).
+    std::vector<dealii::Polynomials::Polynomial<double>> polynomials_1d;
+    std::vector<unsigned int>                            numbering_inverse;
+    std::vector<double>                                  one_d;
+    std::vector<dealii::Point<dim>>                      points;
+    std::vector<double>                                  values;
+    std::vector<dealii::Tensor<1, dim>>                  reference_gradients;
+    std::vector<dealii::Tensor<1, dim>>                  gradients;
+    std::vector<double>                                  determinants;
+    // Scratch for one point's evaluation.
+    std::vector<double>                 point_values;
+    std::vector<dealii::Tensor<1, dim>> point_gradients;
+    std::vector<dealii::Tensor<2, dim>> no_second;
+    std::vector<dealii::Tensor<3, dim>> no_third;
+    std::vector<dealii::Tensor<4, dim>> no_fourth;
   };
 } // namespace ImmersedGrains
 
