@@ -60,28 +60,16 @@ namespace ImmersedGrains
     for (unsigned int q = 0; q < points.size(); ++q)
     {
       // J_ij = dx_i/dxi_j of the d-linear map through the cell's vertices.
-      // The d-linear functions' gradients written out as in
-      // dealii::GeometryInfo::d_linear_shape_function_gradient() (the
-      // same products, so the same bits), without a call per vertex.
-      std::array<std::array<double, 2>, dim> factor;
-      for (unsigned int k = 0; k < dim; ++k)
-        factor[k] = {{1 - points[q][k], points[q][k]}};
       dealii::Tensor<2, dim> jacobian;
       for (const unsigned int v : dealii::GeometryInfo<dim>::vertex_indices())
-        for (unsigned int j = 0; j < dim; ++j)
-        {
-          double shape = 0;
-          for (unsigned int k = 0, n_factors = 0; k < dim; ++k)
-            if (k != j)
-            {
-              const double f = factor[k][(v >> k) & 1];
-              shape          = n_factors++ == 0 ? f : shape * f;
-            }
-          if (((v >> j) & 1) == 0)
-            shape = -shape;
-          for (unsigned int i = 0; i < dim; ++i)
-            jacobian[i][j] += vertices[v][i] * shape;
-        }
+      {
+        const dealii::Tensor<1, dim> shape =
+          dealii::GeometryInfo<dim>::d_linear_shape_function_gradient(points[q],
+                                                                      v);
+        for (unsigned int i = 0; i < dim; ++i)
+          for (unsigned int j = 0; j < dim; ++j)
+            jacobian[i][j] += vertices[v][i] * shape[j];
+      }
       determinants[q]                      = std::abs(determinant(jacobian));
       const dealii::Tensor<2, dim> inverse = invert(jacobian);
       // grad_x N = J^{-T} grad_xi N.
