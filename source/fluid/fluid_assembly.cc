@@ -352,54 +352,119 @@ namespace ImmersedGrains
       }
     }
 
-    // The cell's coefficients of the current iterate and of its history.
+    // The cell's coefficients of the current iterate and of its history,
+    // as gathered (current, old, older: by local DoF) and blocked by
+    // velocity component for the point loop (velocity[c][a] for Q2
+    // function a; history[c][a] the BDF combination a1 u^n + a2 u^{n-1};
+    // last[c][a] u^n), so that evaluate_point_state() reads contiguous
+    // arrays and computes the history once per cell, not once per point.
+    template <int dim>
     struct LocalSolutions
     {
-      std::vector<double> current, old, older;
-      bool                with_history      = false;
-      bool                drag_against_last = false;
+      void
+      block_by_component(const ScalarDofs<dim>       &dofs,
+                         const std::array<double, 3> &bdf)
+      {
+        const unsigned int n_s = dofs.velocity.size();
+        for (unsigned int c = 0; c < dim; ++c)
+        {
+          velocity[c].resize(n_s);
+          history[c].resize(n_s);
+          last[c].resize(n_s);
+          for (unsigned int a = 0; a < n_s; ++a)
+          {
+            const unsigned int k = dofs.velocity[a][c];
+            velocity[c][a]       = current[k];
+            if (with_history)
+              history[c][a] = bdf[1] * old[k] + bdf[2] * older[k];
+            if (drag_against_last)
+              last[c][a] = old[k];
+          }
+        }
+        pressure.resize(dofs.pressure.size());
+        for (unsigned int b = 0; b < dofs.pressure.size(); ++b)
+          pressure[b] = current[dofs.pressure[b]];
+      }
+
+      std::vector<double>                  current, old, older;
+      std::array<std::vector<double>, dim> velocity, history, last;
+      std::vector<double>                  pressure;
+      bool                                 with_history      = false;
+      bool                                 drag_against_last = false;
     };
 
     // The current iterate, its history and the mixture at point @p q.
+    // Each sum runs over the shape functions in ascending order into a
+    // local accumulator, which the compiler keeps in a register: summed
+    // into @p state directly, every addition waited on the store of the
+    // one before.
     template <int dim>
     void
     evaluate_point_state(const ScalarShapes<dim>      &shapes,
-                         const ScalarDofs<dim>        &dofs,
-                         const LocalSolutions         &local,
-                         const std::array<double, 3>  &bdf,
+                         const LocalSolutions<dim>    &local,
                          const MixtureValues<dim>     &mixture,
                          const unsigned int            q,
                          const dealii::Vector<double> *forcing,
                          PointState<dim>              &state)
     {
-      const auto &N   = shapes.N;
-      const auto &G   = shapes.G;
-      state.u         = dealii::Tensor<1, dim>();
-      state.u_history = dealii::Tensor<1, dim>();
-      state.u_last    = dealii::Tensor<1, dim>();
-      state.grad_u    = dealii::Tensor<2, dim>();
-      state.p         = 0;
-      state.grad_p    = dealii::Tensor<1, dim>();
-      for (unsigned int a = 0; a < N.size(); ++a)
+      const double                   *N   = shapes.N.data();
+      const unsigned int              n_s = shapes.N.size();
+      std::array<const double *, dim> G, u;
+      for (unsigned int d = 0; d < dim; ++d)
+      {
+        G[d] = shapes.G[d].data();
+        u[d] = local.velocity[d].data();
+      }
+      double value[dim]         = {};
+      double gradient[dim][dim] = {};
+      for (unsigned int a = 0; a < n_s; ++a)
         for (unsigned int c = 0; c < dim; ++c)
         {
-          const unsigned int k = dofs.velocity[a][c];
-          state.u[c] += local.current[k] * N[a];
+          value[c] += u[c][a] * N[a];
           for (unsigned int d = 0; d < dim; ++d)
-            state.grad_u[c][d] += local.current[k] * G[d][a];
-          if (local.with_history)
-            state.u_history[c] +=
-              (bdf[1] * local.old[k] + bdf[2] * local.older[k]) * N[a];
-          if (local.drag_against_last)
-            state.u_last[c] += local.old[k] * N[a];
+            gradient[c][d] += u[c][a] * G[d][a];
         }
-      for (unsigned int b = 0; b < shapes.Np.size(); ++b)
+      for (unsigned int c = 0; c < dim; ++c)
       {
-        const double value = local.current[dofs.pressure[b]];
-        state.p += value * shapes.Np[b];
+        state.u[c] = value[c];
         for (unsigned int d = 0; d < dim; ++d)
-          state.grad_p[d] += value * shapes.Gp[d][b];
+          state.grad_u[c][d] = gradient[c][d];
       }
+
+      double history[dim] = {}, last[dim] = {};
+      if (local.with_history)
+        for (unsigned int c = 0; c < dim; ++c)
+        {
+          const double *h = local.history[c].data();
+          for (unsigned int a = 0; a < n_s; ++a)
+            history[c] += h[a] * N[a];
+        }
+      if (local.drag_against_last)
+        for (unsigned int c = 0; c < dim; ++c)
+        {
+          const double *l = local.last[c].data();
+          for (unsigned int a = 0; a < n_s; ++a)
+            last[c] += l[a] * N[a];
+        }
+      for (unsigned int c = 0; c < dim; ++c)
+      {
+        state.u_history[c] = history[c];
+        state.u_last[c]    = last[c];
+      }
+
+      const double      *Np  = shapes.Np.data();
+      const unsigned int n_p = shapes.Np.size();
+      double             p = 0, grad_p[dim] = {};
+      for (unsigned int b = 0; b < n_p; ++b)
+      {
+        const double value_b = local.pressure[b];
+        p += value_b * Np[b];
+        for (unsigned int d = 0; d < dim; ++d)
+          grad_p[d] += value_b * shapes.Gp[d][b];
+      }
+      state.p = p;
+      for (unsigned int d = 0; d < dim; ++d)
+        state.grad_p[d] = grad_p[d];
       state.phi                   = mixture.fluid_fraction[q];
       state.grad_phi              = mixture.fluid_fraction_gradient[q];
       state.beta                  = mixture.drag_coefficient[q];
@@ -436,17 +501,31 @@ namespace ImmersedGrains
       const auto        &N   = shapes.N;
       const auto        &G   = shapes.G;
       const unsigned int n_s = N.size();
-      for (unsigned int a = 0; a < n_s; ++a)
-        for (unsigned int c = 0; c < dim; ++c)
-        {
-          double stress_a = 0;
-          for (unsigned int d = 0; d < dim; ++d)
-            stress_a += m.stress[c][d] * G[d][a];
-          integrals.rhs_u[a * dim + c] -=
-            (m.force[c] * N[a] + stress_a -
-             m.pressure * (state.phi * G[c][a] + state.grad_phi[c] * N[a])) *
-            JxW;
-        }
+      {
+        // The coefficients copied out, so that the writes into rhs_u do
+        // not make the compiler read them again for every a.
+        const dealii::Tensor<1, dim>    force    = m.force;
+        const dealii::Tensor<2, dim>    stress   = m.stress;
+        const dealii::Tensor<1, dim>    grad_phi = state.grad_phi;
+        const double                    pressure = m.pressure;
+        const double                    phi      = state.phi;
+        const double                   *Na       = N.data();
+        std::array<const double *, dim> Ga;
+        for (unsigned int d = 0; d < dim; ++d)
+          Ga[d] = G[d].data();
+        double *rhs = integrals.rhs_u.data();
+        for (unsigned int a = 0; a < n_s; ++a)
+          for (unsigned int c = 0; c < dim; ++c)
+          {
+            double stress_a = 0;
+            for (unsigned int d = 0; d < dim; ++d)
+              stress_a += stress[c][d] * Ga[d][a];
+            rhs[a * dim + c] -=
+              (force[c] * Na[a] + stress_a -
+               pressure * (phi * Ga[c][a] + grad_phi[c] * Na[a])) *
+              JxW;
+          }
+      }
 
       const double w_mass    = m.reaction * JxW;
       const double w_viscous = m.diffusion * JxW;
@@ -676,7 +755,7 @@ namespace ImmersedGrains
     dealii::Vector<double>                       cell_reaction(dofs_per_cell);
     const double                                 wall_gap = geometry.wall_gap();
     std::vector<dealii::types::global_dof_index> dof_indices(dofs_per_cell);
-    LocalSolutions                               local;
+    LocalSolutions<dim>                          local;
     local.current.resize(dofs_per_cell);
     local.old.resize(dofs_per_cell);
     local.older.resize(dofs_per_cell);
@@ -768,6 +847,7 @@ namespace ImmersedGrains
                     [](const double b) { return b != 0; });
       if (local.drag_against_last && !local.with_history)
         cell_gather->gather(cell_number, old_solution, local.old);
+      local.block_by_component(dofs, bdf);
       const double h            = std::pow(cell->measure(), 1.0 / dim);
       const double floor_factor = schur_floor_factor(h, wall_gap);
       using DragAveraging       = typename FluidParameters<dim>::DragAveraging;
@@ -794,14 +874,8 @@ namespace ImmersedGrains
       for (unsigned int q = 0; q < n_q; ++q)
       {
         const ScalarShapes<dim> &shapes = cell_shapes[q];
-        evaluate_point_state(shapes,
-                             dofs,
-                             local,
-                             bdf,
-                             mixture,
-                             q,
-                             terms.forcing ? &f[q] : nullptr,
-                             state);
+        evaluate_point_state(
+          shapes, local, mixture, q, terms.forcing ? &f[q] : nullptr, state);
         MomentumCoefficients<dim> m;
         for (const auto *term : terms.at_points)
           term->point(state, shapes, JxW_values[q], m, integrals);
