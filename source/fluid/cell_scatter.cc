@@ -70,6 +70,9 @@ namespace ImmersedGrains
   CellScatter<dim>::clear()
   {
     pairs.clear();
+    pair_entries.clear();
+    pair_row_pointers.clear();
+    pair_diagonal_dof.clear();
     direct_index.clear();
     direct_remote_start.clear();
     condensed_index.clear();
@@ -239,10 +242,15 @@ namespace ImmersedGrains
         if (coupling(fe.system_to_component_index(i).first,
                      fe.system_to_component_index(j).first) !=
             dealii::DoFTools::none)
+        {
           pairs.push_back({static_cast<std::uint16_t>(i),
                            static_cast<std::uint16_t>(j),
                            dof_block[i],
                            dof_block[j]});
+          pair_entries.push_back(i * dofs_per_cell + j);
+          pair_row_pointers.push_back(2 * i + dof_block[j]);
+          pair_diagonal_dof.push_back(i == j ? i : dofs_per_cell);
+        }
 
     const auto &blocks = matrix.get_row_indices();
     std::vector<dealii::types::global_dof_index> dofs(dofs_per_cell);
@@ -603,6 +611,43 @@ namespace ImmersedGrains
     const std::uint32_t *slot = direct_remote_start[d] == no_remote ?
                                   nullptr :
                                   remote_slots.data() + direct_remote_start[d];
+    if (slot == nullptr)
+    {
+      // Cells without another rank's rows: every entry goes to its
+      // position, without the tests for remote rows and the bit look-ups
+      // of fixed ones in the loop (which cost more than the writes).
+      double *const *const       pointers = row_pointers.data();
+      const double *const        values   = &cell_matrix(0, 0);
+      const std::uint32_t *const entries  = pair_entries.data();
+      const std::uint16_t *const row_of   = pair_row_pointers.data();
+      if (!any_fixed)
+        for (std::size_t p = 0; p < pairs.size(); ++p)
+        {
+          if (cell_slots[p] != skip)
+            pointers[row_of[p]][cell_slots[p]] += values[entries[p]];
+        }
+      else
+      {
+        cell_fixed_dofs.resize(dofs_per_cell + 1);
+        for (unsigned int i = 0; i < dofs_per_cell; ++i)
+          cell_fixed_dofs[i] = fixed[first_dof + i];
+        cell_fixed_dofs[dofs_per_cell]          = false;
+        const std::uint16_t *const diagonal_dof = pair_diagonal_dof.data();
+        for (std::size_t p = 0; p < pairs.size(); ++p)
+        {
+          if (cell_slots[p] == skip)
+            continue;
+          double value = values[entries[p]];
+          if (cell_fixed_dofs[diagonal_dof[p]])
+            value = value != 0 ? std::abs(value) : mean_diagonal;
+          pointers[row_of[p]][cell_slots[p]] += value;
+        }
+      }
+      for (unsigned int i = 0; i < dofs_per_cell; ++i)
+        if (!any_fixed || !fixed[first_dof + i])
+          vector_values[dof_block[i]][cell_rows[i]] += cell_rhs(i);
+      return;
+    }
     for (std::size_t p = 0; p < pairs.size(); ++p)
     {
       if (cell_slots[p] == skip)

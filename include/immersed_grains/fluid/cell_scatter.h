@@ -134,7 +134,15 @@ namespace ImmersedGrains
       std::uint8_t  row_block, column_block;
     };
     std::vector<Pair> pairs;
-    unsigned int      dofs_per_cell = 0;
+    // Each pair's entry in the cell matrix (i * dofs_per_cell + j), its
+    // row pointer (2 i + column block), and its local DoF where it is a
+    // diagonal entry (else dofs_per_cell), for add()'s loop over the cells
+    // without another rank's rows.
+    std::vector<std::uint32_t> pair_entries;
+    std::vector<std::uint16_t> pair_row_pointers;
+    std::vector<std::uint16_t> pair_diagonal_dof;
+    mutable std::vector<char>  cell_fixed_dofs; // add()'s, per cell
+    unsigned int               dofs_per_cell = 0;
 
     // Per locally owned cell: its number among the direct cells, or -1.
     std::vector<int> direct_index;
