@@ -25,7 +25,7 @@ namespace ImmersedGrains
    * reference values and gradients are kept until the points change, and a cell
    * costs only its Jacobians. This replaces a dealii::FEPointEvaluation built
    * per cell, whose set-up (tensor-product shape data) cost more than the
-   * evaluation itself: 12 % of a 2D cloud step (doc/performance.md).
+   * evaluation itself (doc/performance.md, "Shape functions at the grains").
    */
   template <int dim>
   class CellPointShapes
