@@ -510,6 +510,22 @@ namespace ImmersedGrains
       double                 theta     = 1;
       double                 momentum  = 0; // beta: y = p + beta (p - p_old)
 
+      // Grain i's slot in the work arrays (grains, spins), slot_of[i];
+      // the identity where empty. Walls keep theirs after the grains.
+      std::vector<unsigned int> slot_of;
+
+      unsigned int
+      slot(const unsigned int grain) const
+      {
+        return grain < slot_of.size() ? slot_of[grain] : grain;
+      }
+
+      /// The grains' slots in the order the sorted rows first read them
+      /// (after order_rows()).
+      void
+      order_slots(const std::vector<GrainPair<dim>>   &pairs,
+                  const std::vector<WallContact<dim>> &wall_contacts);
+
       // Contact m of the lists given to setup() (pairs, then walls) is row
       // row_of_input[m] of the work arrays, which are in sweep order.
       std::vector<unsigned int>                    row_of_input;
