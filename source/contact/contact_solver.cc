@@ -495,7 +495,7 @@ namespace ImmersedGrains
       // three quarters of a sweep. The grains get their slots in the order
       // the sweep first reads them, the grains without a contact after
       // them, so that a layer's grains lie together.
-      if (keyed_rows.empty() || row_of_input.empty())
+      if (keyed_rows.empty())
         return;
       constexpr unsigned int none = std::numeric_limits<unsigned int>::max();
       slot_of.assign(n_grains, none);
