@@ -178,6 +178,16 @@ end
      "-0.5\nend\n",
      "Restitution",
      "-0.5"},
+    {"rolling_friction_without_friction",
+     "set Dimension = 2\nsubsection Contacts\n  set Rolling friction = "
+     "0.1\nend\n",
+     "Rolling friction",
+     "0.1"},
+    {"rolling_friction_with_apgd",
+     "set Dimension = 2\nsubsection Contacts\n  set Friction = 0.5\n  set "
+     "Solver = apgd\n  set Rolling friction = 0.2\nend\n",
+     "Rolling friction",
+     "0.2"},
     {"fixed_region_one_corner",
      "set Dimension = 2\nsubsection Grains\n  set Fixed region = 0, "
      "0\nend\n",

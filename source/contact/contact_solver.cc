@@ -104,6 +104,12 @@ namespace ImmersedGrains
                   dealii::ExcMessage(
                     "ContactSolver: the friction coefficient must not be "
                     "negative."));
+      AssertThrow(p.rolling_friction == 0 ||
+                    (p.rolling_friction > 0 && p.friction > 0 &&
+                     p.method == ContactMethod::gauss_seidel),
+                  dealii::ExcMessage(
+                    "ContactSolver: rolling friction needs friction and the "
+                    "Gauss-Seidel method."));
       AssertThrow(p.tolerance > 0 && p.overlap_tolerance > 0,
                   dealii::ExcMessage(
                     "ContactSolver: the tolerances must be positive."));
@@ -296,6 +302,8 @@ namespace ImmersedGrains
       keys.resize(n_rows);
       key_sign.resize(n_rows);
       friction_rows.resize(friction ? n_rows : 0);
+      rolling_rows.resize(friction && parameters.rolling_friction > 0 ? n_rows :
+                                                                        0);
       smallest_radius = (n_rows > 0 ? std::numeric_limits<double>::max() : 0.);
 
       const auto id = [&](const unsigned int i) -> std::uint64_t
@@ -403,6 +411,18 @@ namespace ImmersedGrains
                            r_j * r_j * spins[row.j].inverse_inertia;
         f.inverse_w_t    = (w_t > 0 ? 1. / w_t : 0.);
         friction_rows[k] = f;
+      }
+      if (!rolling_rows.empty())
+      {
+        RollingRow   r{};
+        const double w_r =
+          spins[row.i].inverse_inertia + spins[row.j].inverse_inertia;
+        r.inverse_w_r = (w_r > 0 ? 1. / w_r : 0.);
+        // A wall rolls under a grain like a grain of infinite radius.
+        const double rolled = (r_j > 0 ? r_i * r_j / (r_i + r_j) : r_i);
+        r.limit             = parameters.rolling_friction * rolled;
+        r.inverse_r_rolled  = 1. / rolled;
+        rolling_rows[k]     = r;
       }
     }
 
@@ -666,8 +686,9 @@ namespace ImmersedGrains
     SweepResult
     ContactSolver<dim>::sweep()
     {
-      const SweepResult result =
-        (with_friction() ? sweep_rows<true>() : sweep_rows<false>());
+      const SweepResult result = (with_rolling()  ? sweep_rows<true, true>() :
+                                  with_friction() ? sweep_rows<true, false>() :
+                                                    sweep_rows<false, false>());
       // Alternating the order lets information cross a chain of contacts in
       // both directions at the same speed (a column on a floor converges
       // no matter in which order its contacts were listed).
@@ -678,7 +699,7 @@ namespace ImmersedGrains
 
 
     template <int dim>
-    template <bool with_friction>
+    template <bool with_friction, bool with_rolling>
     SweepResult
     ContactSolver<dim>::sweep_rows()
     {
@@ -686,6 +707,7 @@ namespace ImmersedGrains
       SpinSlot *const    s      = spins.data();
       Row *const         rw     = rows.data();
       FrictionRow *const fr     = friction_rows.data();
+      RollingRow *const  rr     = rolling_rows.data();
       const double       mu     = parameters.friction;
       const long         n      = rows.size();
       const long         start  = (forward ? 0 : n - 1);
@@ -775,6 +797,47 @@ namespace ImmersedGrains
               sa.inverse_inertia * f.radius_i * torque[d];
             sb.angular_velocity[d] -=
               sb.inverse_inertia * f.radius_j * torque[d];
+          }
+          if constexpr (with_rolling)
+          {
+            // The relative rolling w = omega_j - omega_i (its part about
+            // axes in the tangent plane in 3D: spinning about the normal
+            // is free) is brought to zero inside the disc |p_r| <= mu_r R*
+            // p_n, as the tangential slip inside Coulomb's cone.
+            RollingRow &r = rr[k];
+            double      w[spin_dim], p_r[spin_dim], spin_n = 0, norm_r2 = 0;
+            for (unsigned int d = 0; d < spin_dim; ++d)
+              w[d] = sb.angular_velocity[d] - sa.angular_velocity[d];
+            if constexpr (dim == 3)
+            {
+              for (unsigned int d = 0; d < dim; ++d)
+                spin_n += w[d] * row.normal[d];
+              for (unsigned int d = 0; d < dim; ++d)
+                w[d] -= spin_n * row.normal[d];
+            }
+            for (unsigned int d = 0; d < spin_dim; ++d)
+            {
+              p_r[d] = r.p_r[d] - r.inverse_w_r * w[d];
+              norm_r2 += p_r[d] * p_r[d];
+            }
+            const double limit_r = r.limit * p_n;
+            if (norm_r2 > limit_r * limit_r)
+            {
+              const double scale = limit_r / std::sqrt(norm_r2);
+              for (unsigned int d = 0; d < spin_dim; ++d)
+                p_r[d] *= scale;
+            }
+            for (unsigned int d = 0; d < spin_dim; ++d)
+            {
+              const double dp_r = p_r[d] - r.p_r[d];
+              r.p_r[d]          = p_r[d];
+              sa.angular_velocity[d] -= sa.inverse_inertia * dp_r;
+              sb.angular_velocity[d] += sb.inverse_inertia * dp_r;
+              // Measured as the tangential force's impulse that would
+              // give the same torque.
+              change2 += dp_r * dp_r * r.inverse_r_rolled * r.inverse_r_rolled;
+              p2 += p_r[d] * p_r[d] * r.inverse_r_rolled * r.inverse_r_rolled;
+            }
           }
           max_d2 = std::max(max_d2, change2);
           max_p2 = std::max(max_p2, p2);
@@ -868,6 +931,15 @@ namespace ImmersedGrains
     ContactSolver<dim>::with_friction() const
     {
       return parameters.friction > 0 && !correcting;
+    }
+
+
+
+    template <int dim>
+    bool
+    ContactSolver<dim>::with_rolling() const
+    {
+      return with_friction() && !rolling_rows.empty();
     }
 
 

@@ -181,6 +181,18 @@ namespace ImmersedGrains
                         "0",
                         Double(0),
                         "Coulomb friction coefficient; > 0 adds rotation.");
+      prm.declare_entry(
+        "Rolling friction",
+        "0",
+        Double(0),
+        "Rolling friction coefficient mu_r (needs Friction > 0 and Solver "
+        "= gauss-seidel): each contact resists its two grains' relative "
+        "rolling with a torque of at most mu_r R* N, N its normal force, R* "
+        "= r_i r_j / (r_i + r_j) between two grains and r_i against a wall, "
+        "as Coulomb's friction resists sliding; standing for the shape and "
+        "the contact area that roll a real grain less than a sphere. A "
+        "grain rolls down a plane inclined at theta only where tan(theta) "
+        "> mu_r (doc/contacts.md). 0: grains roll freely.");
       prm.declare_entry("Tolerance",
                         "1e-6",
                         Double(0),
@@ -629,6 +641,7 @@ namespace ImmersedGrains
       contacts_enabled          = prm.get_bool("Enabled");
       contact.restitution       = prm.get_double("Restitution");
       contact.friction          = prm.get_double("Friction");
+      contact.rolling_friction  = prm.get_double("Rolling friction");
       contact.tolerance         = prm.get_double("Tolerance");
       contact.overlap_tolerance = prm.get_double("Overlap tolerance");
       contact.max_iterations    = prm.get_integer("Max iterations");
@@ -641,6 +654,16 @@ namespace ImmersedGrains
       alert_distance              = prm.get_double("Alert distance");
       stop_on_failure             = prm.get_bool("Stop on failure");
       sweep_along_gravity         = prm.get("Sweep order") == "height";
+      where.require(contact.rolling_friction == 0 || contact.friction > 0,
+                    "Rolling friction",
+                    prm.get("Rolling friction"),
+                    "needs Friction > 0 (without friction the grains do "
+                    "not rotate)");
+      where.require(contact.rolling_friction == 0 ||
+                      contact.method == Contact::ContactMethod::gauss_seidel,
+                    "Rolling friction",
+                    prm.get("Rolling friction"),
+                    "needs Solver = gauss-seidel");
       where.require(contact.tolerance > 0,
                     "Tolerance",
                     prm.get("Tolerance"),

@@ -91,6 +91,15 @@ namespace ImmersedGrains
       /// Coulomb friction coefficient mu >= 0; 0 switches rotation off.
       double friction = 0;
 
+      /// Rolling friction coefficient mu_r >= 0 (Gauss-Seidel with
+      /// friction > 0 only): a contact's torque against the relative
+      /// rolling of its two grains is at most mu_r R* p_n, R* = r_i r_j /
+      /// (r_i + r_j) for two grains and r_i against a wall. Stands for
+      /// what rolls a real grain less than a sphere: its shape and the
+      /// contact's finite area (Iwashita & Oda 1998). 0: spheres roll
+      /// freely.
+      double rolling_friction = 0;
+
       /// Converged when no impulse changed by more than this times the
       /// largest impulse during the last sweep ...
       double tolerance = 1e-6;
@@ -465,6 +474,16 @@ namespace ImmersedGrains
         double radius_j;
       };
 
+      // Rolling friction: the angular impulse on grain j (on i: its
+      // negative), tangential in 3D; not warm-started.
+      struct RollingRow
+      {
+        double p_r[spin_dim];
+        double inverse_w_r;      // 1 / (1 / I_i + 1 / I_j)
+        double limit;            // mu_r R*: |p_r| <= limit p_n
+        double inverse_r_rolled; // 1 / R*: p_r / R* is a force's impulse
+      };
+
       using Key = std::pair<std::uint64_t, std::uint64_t>;
 
       struct CachedImpulse
@@ -485,6 +504,7 @@ namespace ImmersedGrains
       std::vector<SpinSlot>    spins;
       std::vector<Row>         rows;
       std::vector<FrictionRow> friction_rows;
+      std::vector<RollingRow>  rolling_rows;
       std::vector<double>      gaps;       // of the current phase
       std::vector<double>      start_gaps; // at the start of the step
 
@@ -611,6 +631,10 @@ namespace ImmersedGrains
       bool
       with_friction() const;
 
+      /// So does rolling friction.
+      bool
+      with_rolling() const;
+
       void
       order_rows(const std::vector<GrainPair<dim>>   &pairs,
                  const std::vector<WallContact<dim>> &wall_contacts,
@@ -632,7 +656,7 @@ namespace ImmersedGrains
                     const double       dp_n,
                     const double      *dp_t);
 
-      template <bool with_friction>
+      template <bool with_friction, bool with_rolling>
       SweepResult
       sweep_rows();
 
