@@ -590,8 +590,12 @@ namespace ImmersedGrains
       pcout << "  grains: " << grains->particle_handler().n_global_particles()
             << ", " << grains->layout().n_properties << " properties per grain";
       if (grain_parameters.contacts_enabled)
-        pcout << "; contacts: e = " << c.restitution << ", mu = " << c.friction
-              << ", tolerance " << c.tolerance;
+      {
+        pcout << "; contacts: e = " << c.restitution << ", mu = " << c.friction;
+        if (c.rolling_friction > 0)
+          pcout << ", rolling mu_r = " << c.rolling_friction;
+        pcout << ", tolerance " << c.tolerance;
+      }
       else
         pcout << "; contacts off";
       pcout << '\n';
