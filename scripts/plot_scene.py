@@ -66,6 +66,15 @@ def read_vtu(path):
     # Points have no Name in deal.II's files.
     m = re.search(r'<Points>\s*<DataArray type="(\w+)" NumberOfComponents='
                   r'"3" format="(\w+)"[^>]*>(.*?)</DataArray>', text, re.S)
+    if m is None:
+        # A rank that holds no grains writes a piece without points, its
+        # arrays empty and without a format.
+        for m in re.finditer(r'<DataArray type="(\w+)" Name="(\w+)"'
+                             r'(?: NumberOfComponents="(\d+)")?>', text):
+            dtype, name, ncomp = m.groups()
+            arrays.setdefault(name, np.zeros((0, int(ncomp)) if ncomp
+                                             else 0, dtype=TYPES[dtype]))
+        return np.zeros((0, 3)), arrays, []
     dtype, fmt, body = m.groups()
     points = (np.array(body.split(), dtype=float) if fmt == "ascii"
               else decode(body, TYPES[dtype])).reshape(-1, 3)
