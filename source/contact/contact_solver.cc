@@ -549,6 +549,9 @@ namespace ImmersedGrains
         out << c.key.first << ' ' << c.key.second << ' ' << c.p_n;
         for (unsigned int d = 0; d < dim; ++d)
           out << ' ' << c.p_t[d];
+        if (parameters.rolling_friction > 0)
+          for (unsigned int d = 0; d < spin_dim; ++d)
+            out << ' ' << c.p_r[d];
         out << '\n';
       }
       out << std::defaultfloat;
@@ -564,7 +567,7 @@ namespace ImmersedGrains
       while (std::getline(in, line))
       {
         std::istringstream fields(line);
-        CachedImpulse      c;
+        CachedImpulse      c{};
         std::string        value;
         if (!(fields >> c.key.first >> c.key.second >> value))
           continue;
@@ -574,6 +577,11 @@ namespace ImmersedGrains
           fields >> value;
           c.p_t[d] = std::strtod(value.c_str(), nullptr);
         }
+        // Rolling impulses follow where the run that saved them had
+        // rolling friction.
+        for (unsigned int d = 0; d < spin_dim; ++d)
+          if (fields >> value)
+            c.p_r[d] = std::strtod(value.c_str(), nullptr);
         cache.push_back(c);
       }
       const auto by_key = [](const CachedImpulse &a, const CachedImpulse &b)
@@ -601,6 +609,7 @@ namespace ImmersedGrains
       std::size_t       cursor   = 0;
       Key               last(0, 0);
       const bool        friction = (parameters.friction > 0);
+      const bool        rolling  = with_rolling();
       for (unsigned int k = 0; k < rows.size(); ++k)
       {
         const Key &key = keys[k];
@@ -645,6 +654,47 @@ namespace ImmersedGrains
             p_t[d] = friction_rows[k].p_t[d] = t[d];
         }
         apply_impulse(k, row.p_n, p_t);
+        if (rolling)
+          warm_start_rolling(k, cache[cursor].p_r);
+      }
+    }
+
+
+
+    template <int dim>
+    void
+    ContactSolver<dim>::warm_start_rolling(const unsigned int k,
+                                           const double      *cached_p_r)
+    {
+      // As the tangential impulse: the part about axes in the new tangent
+      // plane (3D), inside the new limit. A pile held by rolling friction
+      // then starts each step with its rolling impulses instead of
+      // rebuilding them from zero in the sweeps.
+      const Row  &row = rows[k];
+      RollingRow &r   = rolling_rows[k];
+      double      p_r[spin_dim], norm2 = 0;
+      for (unsigned int d = 0; d < spin_dim; ++d)
+        p_r[d] = key_sign[k] * cached_p_r[d];
+      if constexpr (dim == 3)
+      {
+        double along_normal = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          along_normal += p_r[d] * row.normal[d];
+        for (unsigned int d = 0; d < dim; ++d)
+          p_r[d] -= along_normal * row.normal[d];
+      }
+      for (unsigned int d = 0; d < spin_dim; ++d)
+        norm2 += p_r[d] * p_r[d];
+      const double limit = r.limit * row.p_n;
+      const double scale =
+        (norm2 > limit * limit ? limit / std::sqrt(norm2) : 1.);
+      SpinSlot &sa = spins[row.i];
+      SpinSlot &sb = spins[row.j];
+      for (unsigned int d = 0; d < spin_dim; ++d)
+      {
+        r.p_r[d] = scale * p_r[d];
+        sa.angular_velocity[d] -= sa.inverse_inertia * r.p_r[d];
+        sb.angular_velocity[d] += sb.inverse_inertia * r.p_r[d];
       }
     }
 
@@ -1039,7 +1089,13 @@ namespace ImmersedGrains
         out.normal[q]             = rows[k].p_n;
         out.tangential[q]         = p_t;
         if (rows[k].p_n > 0)
-          cache.push_back({keys[k], rows[k].p_n, key_sign[k] * p_t});
+        {
+          CachedImpulse c{keys[k], rows[k].p_n, key_sign[k] * p_t, {}};
+          if (!rolling_rows.empty())
+            for (unsigned int d = 0; d < spin_dim; ++d)
+              c.p_r[d] = key_sign[k] * rolling_rows[k].p_r[d];
+          cache.push_back(c);
+        }
       }
 
       // Pairs and walls each come sorted from the neighbour searches, so

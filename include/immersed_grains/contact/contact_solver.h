@@ -475,7 +475,7 @@ namespace ImmersedGrains
       };
 
       // Rolling friction: the angular impulse on grain j (on i: its
-      // negative), tangential in 3D; not warm-started.
+      // negative), tangential in 3D.
       struct RollingRow
       {
         double p_r[spin_dim];
@@ -491,6 +491,7 @@ namespace ImmersedGrains
         Key            key;
         double         p_n;
         Tensor<1, dim> p_t;
+        double         p_r[spin_dim]; // rolling; zero without it
       };
 
       ContactParameters parameters;
@@ -650,6 +651,11 @@ namespace ImmersedGrains
 
       void
       warm_start();
+
+      /// Starts row @p k's rolling impulse from the kept one, @p cached_p_r
+      /// (on the key's second grain).
+      void
+      warm_start_rolling(const unsigned int k, const double *cached_p_r);
 
       void
       apply_impulse(const unsigned int k,
