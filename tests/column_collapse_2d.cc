@@ -8,8 +8,10 @@
 // the discs settle through the liquid with friction 1 (they lock where
 // they land: bulk packing 0.750, about 6 mm tall) or without friction
 // (they slide into a dense packing: 0.819, 5.5 mm). Each is released at
-// the end of a tank 18 mm long, open at the top, with friction 0.4 and
-// the default Drag distribution (auto: packed discs get a filter of three
+// the end of a tank 18 mm long, open at the top, with friction 0.4, the
+// rolling friction 0.2 that the same discs' dry collapse calibrates
+// against dry experiments (tests/column_collapse_dry_2d), and the
+// default Drag distribution (auto: packed discs get a filter of three
 // diameters, 0.68 mm, so that the liquid's flow through the column is
 // resolved), and left for 0.5 s.
 //
@@ -26,28 +28,27 @@
 // 0.70 mm, and the default on two ranks (doc/validation.md, "Column
 // collapse in a viscous liquid"):
 //  - at 0.1 s the loose front has run out (L - L0)/L0 more than twice as
-//    far as the dense one (1.23-1.27 against 0.27-0.28);
-//  - at 0.5 s the loose run-out exceeds the dense one (2.16-2.30 against
-//    1.43-1.49; Rondon et al.: about twice);
+//    far as the dense one (0.62-0.64 against 0.09-0.10);
+//  - at 0.5 s the loose run-out exceeds twice the dense one (1.68-1.86
+//    against 0.34-0.48). By then the loose column has stopped (the ready
+//    scene: within 1 % of its run-out at 4 s) and the dense one creeps on,
+//    to 0.57 of the loose run-out at 4 s in the scene, where Rondon et al.
+//    measured about half: a run-out below half at 0.5 s is what that
+//    needs. Without rolling friction the dense column has run 0.63-0.68
+//    of the loose run-out by 0.5 s, and this check fails;
 //  - the mean excess over 0.2-0.5 s is positive for the loose column and
-//    negative for the dense one, each by more than 2 % of W (+0.048 to
-//    +0.111 W; -0.26 to -0.31 W). Before 0.2 s the release shears both
-//    columns' bases and the excess under both is negative (to 0.17 s under
-//    the loose one, doc/validation.md's figure; Polania et al. 2024 measure
-//    the same at the start of immersed collapses); from 0.1 s the loose
-//    mean was +0.018 to +0.061 W, too close to the noise;
-//  - the dense column's most negative excess lies below the loose
-//    column's (-0.67 to -0.69 W; -0.47 to -0.56 W, the loose one in the
-//    first 0.05 s, when the release shears its base).
-// With filters of two diameters, half of six runs (0.44-0.50 mm) see a
-// block of the dense column slide off at 0.15 s and run out farther than
-// the loose one: doc/validation.md says why.
-// The two runs take about a minute and a half, serial or on two ranks.
+//    negative for the dense one, each by more than 2 % of W (+0.083 to
+//    +0.133 W; -0.042 to -0.076 W). Before 0.2 s the release shears both
+//    columns' bases and the excess under both is negative (to 0.12 s under
+//    the loose one; Polania et al. 2024 measure the same at the start of
+//    immersed collapses).
+// The lowest excess, at the release, is about the same under both
+// (-0.22 to -0.25 W loose, -0.25 to -0.27 W dense) and is not checked.
+// The two runs take about 40 s, serial or on two ranks.
 #include <deal.II/base/mpi.h>
 
 #include "checkpoint_test_support.h"
 
-#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <string>
@@ -92,6 +93,7 @@ subsection Grains
 end
 subsection Contacts
   set Friction = 0.4
+  set Rolling friction = 0.2
 end
 subsection Coupling
   set Closure porosity in 2D = sphere packing
@@ -111,7 +113,6 @@ end
     double early_run_out; // at 0.1 s
     double run_out;       // at the end, 0.5 s
     double mean_excess;
-    double lowest_excess;
   };
 
   Collapse
@@ -119,19 +120,14 @@ end
   {
     const auto         rows = read_csv_rows(name + "/statistics.csv");
     const unsigned int t    = column_index(rows, "time"),
-                       p    = column_index(rows, "probe_base_pressure"),
                        x    = column_index(rows, "grains_max_x");
     const double L0         = std::stod(rows[1][x]);
-    Collapse     c{0, (std::stod(rows.back()[x]) - L0) / L0, 0, 0};
+    Collapse     c{0, (std::stod(rows.back()[x]) - L0) / L0, 0};
     for (unsigned int r = 1; r < rows.size(); ++r)
-    {
       if (std::abs(std::stod(rows[r][t]) - 0.1) < 1e-9)
         c.early_run_out = (std::stod(rows[r][x]) - L0) / L0;
-      c.lowest_excess = std::min(c.lowest_excess, std::stod(rows[r][p]));
-    }
     c.mean_excess =
       time_average(rows, 0.2 + 1e-9, "probe_base_pressure") / weight;
-    c.lowest_excess /= weight;
     return c;
   }
 } // namespace
@@ -152,12 +148,10 @@ main(int argc, char **argv)
   const auto     yes   = [](const bool b) { return b ? "yes" : "no"; };
   std::cout << "at 0.1 s the loose run-out exceeds twice the dense one: "
             << yes(loose.early_run_out > 2 * dense.early_run_out) << '\n'
-            << "at 0.5 s the loose run-out exceeds the dense one: "
-            << yes(loose.run_out > dense.run_out) << '\n'
+            << "at 0.5 s the loose run-out exceeds twice the dense one: "
+            << yes(loose.run_out > 2 * dense.run_out) << '\n'
             << "loose: mean excess pore pressure > +0.02 W: "
             << yes(loose.mean_excess > 0.02) << '\n'
             << "dense: mean excess pore pressure < -0.02 W: "
-            << yes(dense.mean_excess < -0.02) << '\n'
-            << "dense: lowest excess pore pressure below the loose one's: "
-            << yes(dense.lowest_excess < loose.lowest_excess) << '\n';
+            << yes(dense.mean_excess < -0.02) << '\n';
 }
