@@ -32,38 +32,13 @@ namespace
   run(const std::string &directory, const double end_time, const bool resume)
   {
     std::ostringstream text;
-    text << "set Dimension = 2\nset Time step = 2e-4\nset End time = "
-         << end_time << "\nset Output directory = " << directory << R"(
-subsection Mesh
-  set Lower corner        = 0, 0
-  set Upper corner        = 36e-3, 7.2e-3
-  set Subdivisions        = 80, 16
-  set Boundary conditions = wall, wall, wall, open
-end
-subsection Fluid
-  set Enabled = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 112.5e-6
-  set Density = 2500
-  subsection Placement
-    set Shape = file
-    set File  = )"
-         << IMMERSED_GRAINS_TEST_DIRECTORY
-         << "/../prm/packings/column_collapse_2d_loose.txt"
-         << R"(
-  end
-end
-subsection Contacts
-  set Friction         = 0.4
-  set Rolling friction = 0.2
-end
-subsection Gravity
-  set Vector = 0, -9.81
-end
+    text << ready_scene_text("column_collapse_2d_dry")
+         << "set End time = " << end_time
+         << "\nset Output directory = " << directory << R"(
 subsection Output
-  set Terminal output = quiet
+  set Terminal output    = quiet
+  set Write fields every = 0
+  set Write grain file   = false
 end
 subsection Checkpoint
   set Every steps = 40

@@ -1,5 +1,6 @@
 // What the tests that run whole scenes from a parameter text share (the
-// checkpoint tests, adaptive_band_outrun_2d, fluidized_bed_3d). The
+// checkpoint tests, adaptive_band_outrun_2d, fluidized_bed_3d, the column
+// collapse tests, which run the ready scenes reduced). The
 // checkpoint tests' scene: 81 discs (r = 12.5 um, 2400 kg/m^3) in a ball
 // of 0.25 mm in glycerine, a 2 mm box, an adaptive mesh (levels 2-4,
 // adapted every 3 steps) and contacts: every kind of state a checkpoint
@@ -83,6 +84,26 @@ run_scene(const std::string &file,
   ImmersedGrains::parse_parameter_file(prm, file);
   ImmersedGrains::Simulation<dim> simulation(prm, file, comm);
   simulation.run();
+}
+
+// The text of the ready scene prm/@p name.prm, its packings/ paths made
+// absolute, for a test to append its reductions to: a later `set` of an
+// entry overrides the scene's, so the test runs the scene as it stands in
+// all it does not reduce.
+inline std::string
+ready_scene_text(const std::string &name)
+{
+  const std::string prm =
+    std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/../prm/";
+  std::ifstream      in(prm + name + ".prm");
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string       scene    = text.str();
+  const std::string relative = "= packings/";
+  for (std::size_t at = scene.find(relative); at != std::string::npos;
+       at             = scene.find(relative, at + 1))
+    scene.replace(at, relative.size(), "= " + prm + "packings/");
+  return scene + "\n";
 }
 
 inline void

@@ -57,55 +57,14 @@ using namespace dealii;
 
 namespace
 {
-  const std::string packings =
-    std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/../prm/packings/";
-
   void
   collapse(const std::string &name)
   {
     run_2d_scene(name + ".prm",
-                 "set Dimension = 2\nset Output directory = " + name +
-                   R"(
-set End time  = 0.5
-set Time step = 5e-3
-subsection Mesh
-  set Lower corner        = 0, 0
-  set Upper corner        = 18e-3, 7.2e-3
-  set Subdivisions        = 40, 16
-  set Initial refinement  = 0
-  set Boundary conditions = wall, wall, wall, open
-end
-subsection Fluid
-  set Density         = 1010
-  set Viscosity       = 0.012
-  set Advection       = false
-  set Time derivative = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 112.5e-6
-  set Density = 2500
-  subsection Placement
-    set Shape = file
-    set File  = )" +
-                   packings + "column_collapse_2d_" + name + R"(.txt
-  end
-end
-subsection Contacts
-  set Friction = 0.4
-  set Rolling friction = 0.2
-end
-subsection Coupling
-  set Closure porosity in 2D = sphere packing
-end
-subsection Gravity
-  set Vector = 0, -9.81
-end
-subsection Output
-  set Terminal output = quiet
-  set Probes          = base: 2.25e-3, 1e-4
-end
-)");
+                 ready_scene_text("column_collapse_2d_" + name) +
+                   "set End time = 0.5\nset Output directory = " + name +
+                   "\nsubsection Output\n  set Terminal output = quiet\n"
+                   "  set Write fields every = 0\nend\n");
   }
 
   struct Collapse

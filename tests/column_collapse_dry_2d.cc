@@ -44,45 +44,18 @@ namespace
            const std::string &packing,
            const double       rolling_friction)
   {
-    std::ostringstream mu_r;
-    mu_r << rolling_friction;
+    std::ostringstream reductions;
+    reductions << "set End time = 0.3\nset Output directory = " << name
+               << "\nsubsection Grains\n  subsection Placement\n"
+                  "    set File = "
+               << packings << "column_collapse_2d_" << packing
+               << ".txt\n  end\nend\nsubsection Contacts\n"
+                  "  set Rolling friction = "
+               << rolling_friction
+               << "\nend\nsubsection Output\n  set Terminal output = quiet\n"
+                  "  set Write fields every = 0\nend\n";
     run_2d_scene(name + ".prm",
-                 "set Dimension = 2\nset Output directory = " + name +
-                   R"(
-set End time  = 0.3
-set Time step = 2e-4
-subsection Mesh
-  set Lower corner        = 0, 0
-  set Upper corner        = 36e-3, 7.2e-3
-  set Subdivisions        = 80, 16
-  set Boundary conditions = wall, wall, wall, open
-end
-subsection Fluid
-  set Enabled = false
-end
-subsection Grains
-  set Enabled = true
-  set Radius  = 112.5e-6
-  set Density = 2500
-  subsection Placement
-    set Shape = file
-    set File  = )" +
-                   packings + "column_collapse_2d_" + packing + R"(.txt
-  end
-end
-subsection Contacts
-  set Friction         = 0.4
-  set Rolling friction = )" +
-                   mu_r.str() + R"(
-end
-subsection Gravity
-  set Vector = 0, -9.81
-end
-subsection Output
-  set Terminal output  = quiet
-  set Write grain file = true
-end
-)");
+                 ready_scene_text("column_collapse_2d_dry") + reductions.str());
   }
 
   // The discs' x and y from a grain file ('x y r vx vy' lines, '#' comments).
