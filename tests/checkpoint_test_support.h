@@ -95,7 +95,8 @@ ready_scene_text(const std::string &name)
 {
   const std::string prm =
     std::string(IMMERSED_GRAINS_TEST_DIRECTORY) + "/../prm/";
-  std::ifstream      in(prm + name + ".prm");
+  std::ifstream in(prm + name + ".prm");
+  AssertThrow(in, dealii::ExcMessage("cannot read " + prm + name + ".prm"));
   std::ostringstream text;
   text << in.rdbuf();
   std::string       scene    = text.str();
