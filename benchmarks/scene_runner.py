@@ -33,3 +33,37 @@ def run_scene(prm_text, directory, ranks=1):
     finally:
         os.unlink(prm.name)
     return read_csv(os.path.join(directory, "statistics.csv"))
+
+
+def ready_scene_text(name):
+    """The text of prm/<name>.prm with its packings' paths made absolute,
+    so that it runs from any directory; a study appends its changes (a later
+    'set' overrides an earlier one)."""
+    path = os.path.join(ROOT, "prm", name + ".prm")
+    try:
+        with open(path) as f:
+            text = f.read()
+    except OSError:
+        raise SystemExit("cannot read the scene %s" % path)
+    return text.replace("= packings/",
+                        "= %s/" % os.path.join(ROOT, "prm", "packings"))
+
+
+def end_time(prm_text):
+    """The last top-level 'set End time' of a parameter text."""
+    value = None
+    for line in prm_text.splitlines():
+        words = line.split("#")[0].split("=")
+        if len(words) == 2 and words[0].split() == ["set", "End", "time"]:
+            value = float(words[1])
+    return value
+
+
+def finished(directory, prm_text):
+    """Whether the run of @p prm_text in @p directory reached its end time
+    (a study runs again only what did not)."""
+    path = os.path.join(directory, "statistics.csv")
+    if not os.path.exists(path):
+        return False
+    rows = read_csv(path)
+    return bool(rows) and float(rows[-1]["time"]) >= end_time(prm_text) - 1e-9

@@ -24,7 +24,9 @@ hydrostatic part) in units of the column's buoyant weight per area
 W = (rho_p - rho) g (sum of the discs' areas) / L0; for a 3D slab,
 periodic across its thickness T, W = (rho_p - rho) g (sum of the beads'
 volumes) / (L0 T), T read from the box of the run's parameter file
-(or --thickness). A collapse repeats only to within a spread: runs with
+(or --thickness). The packing inside the mass is measured on each written
+state of the particles (bulk_packing: bins of two diameters inside the
+mass, its edges, the wall and the floor left out). A collapse repeats only to within a spread: runs with
 the time step 1-4 % off end at run-outs up to a fifth apart. `--repeat LOOSE
 DENSE` (as often as wanted) adds such runs of the two scenes: their run-outs are drawn as thin lines,
 and a second table gives each measure's mean and range over all the pairs.
@@ -102,12 +104,35 @@ def box_thickness(directory):
                  "parameter file in %s; give --thickness" % directory)
 
 
+def bulk_packing(centres, radii, dim, thickness):
+    """The packing inside the mass: the x-y plane cut into square bins of
+    two mean diameters, the grains' area (3D: volume over the slab's
+    thickness) in the bins that hold grains and whose neighbours to the
+    left, to the right and above hold grains too, over those bins' area.
+    The bins along the wall (x = 0) and the floor are left out (grains
+    layer against a wall), and so are the edges of the mass."""
+    size = 4.0 * float(np.mean(radii))
+    amount = (math.pi * radii ** 2 if dim == 2 else
+              4.0 / 3.0 * math.pi * radii ** 3 / thickness)
+    ix = np.floor(centres[:, 0] / size).astype(int)
+    iy = np.floor(centres[:, 1] / size).astype(int)
+    grid = np.zeros((ix.max() + 2, iy.max() + 2))
+    np.add.at(grid, (ix, iy), amount)
+    held = grid > 0
+    inside = np.zeros_like(held)
+    inside[1:-1, 1:-1] = (held[1:-1, 1:-1] & held[:-2, 1:-1] & held[2:, 1:-1]
+                          & held[1:-1, 2:])
+    return float(grid[inside].sum() / (inside.sum() * size * size)) \
+        if inside.any() else float("nan")
+
+
 def measure(directory, thickness=None):
     s = statistics(directory)
     L0, H0 = s["grains_max_x"][0], s["grains_max_y"][0]
     per_area = L0
     if s["dim"] == 3:
-        per_area *= thickness if thickness else box_thickness(directory)
+        thickness = thickness if thickness else box_thickness(directory)
+        per_area *= thickness
     W = (RHO_P - RHO) * G * grain_measure(directory, s["dim"]) / per_area
     run_out = (s["grains_max_x"] - L0) / L0
     excess = s["probe_base_pressure"] / W
@@ -119,6 +144,10 @@ def measure(directory, thickness=None):
     late = (s["time"] > TRANSIENT + 1e-9) & (s["time"] <= t90 + 1e-9)
     if not late.any():
         late = s["time"] > TRANSIENT + 1e-9
+    states = particle_states(directory, "plot_column_collapse.py",
+                             ("radius",))
+    packing = np.array([bulk_packing(c, f["radius"], s["dim"], thickness)
+                        for _, c, f in states])
     return dict(
         s=s, L0=L0, H0=H0, W=W, run_out=run_out, excess=excess,
         final=final, t90=t90,
@@ -126,7 +155,10 @@ def measure(directory, thickness=None):
         mean_excess=float(np.sum(excess[late] * s["dt"][late])
                           / np.sum(s["dt"][late])),
         lowest=float(excess.min()), highest=float(excess.max()),
-        states=particle_states(directory, "plot_column_collapse.py"))
+        states=[(t, c) for t, c, _ in states],
+        packing_time=np.array([t for t, _, _ in states]), packing=packing,
+        packing_start=packing[0], packing_lowest=float(np.nanmin(packing)),
+        packing_end=packing[-1])
 
 
 def main():
@@ -197,6 +229,10 @@ def main():
          lambda r: "%+.3f" % r["mean_excess"]),
         ("lowest, highest excess / W",
          lambda r: "%+.2f, %+.2f" % (r["lowest"], r["highest"])),
+        ("packing inside the mass: at the release, lowest, at the end",
+         lambda r: "%.3f, %.3f, %.3f" % (r["packing_start"],
+                                         r["packing_lowest"],
+                                         r["packing_end"])),
     ]
     for label, f in rows:
         print("| %s | %s | %s |" % (label, f(runs["loose"]),
