@@ -24,7 +24,6 @@ import argparse
 import csv
 import math
 import os
-
 import sys
 
 import numpy as np
