@@ -19,7 +19,7 @@ run whose statistics reach its end time is not run again (--analyse-only
 runs nothing). The layers run for the scenes' end times (3 s loose, 15 s
 dense; --dense-end for the dense one). The measures are scripts/plot_avalanche.py's,
 which also draws each slope's figure into its case folder. A slope's pair
-takes 1 to 4 minutes on two cores.
+takes 5 to 10 minutes on two cores.
 """
 import argparse
 import concurrent.futures
