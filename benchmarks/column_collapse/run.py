@@ -2,12 +2,12 @@
 """The column collapses of doc/scenes/column_collapse_2d.md compared with
 Rondon, Pouliquen & Aussillous (2011): the loose and the dense column
 (prm/column_collapse_2d_{loose,dense}.prm) run as pairs, with the rolling
-friction, the time step and the held-grain threshold changed, and the
+friction, the time step or any other parameter changed, and the
 run-outs at the end tabulated against the experiment's "the dense column
 stops at about half the loose run-out".
 
     /usr/bin/python3 benchmarks/column_collapse/run.py [--rolling 0.2,0.3]
-        [--steps 5e-3,4.8e-3] [--threshold 0.01] [--set Contacts/Friction=0.8]
+        [--steps 5e-3,4.8e-3] [--set Contacts/Friction=0.8]
         [--scene column_collapse_2d]
         [--jobs 2] [--ranks 1] [--analyse-only] [--figure collapse.png]
 
@@ -23,7 +23,7 @@ scenes' own rolling friction is kept. The studies of the page:
     run.py --rolling 0.3,100 --steps 4.9e-3,5e-3,5.1e-3 #   one and three pairs
     run.py --steps 2.45e-3,2.5e-3,2.55e-3               # how firm the half is
     run.py --steps 0.99e-3,1e-3,1.01e-3
-    run.py --steps 1e-3 --threshold 0.01
+    run.py --steps 1e-3 --set "Coupling/Resting threshold=0.01"
     run.py --rolling 0 --set Contacts/Friction=0.8 --steps 4.9e-3,5e-3,5.1e-3
     run.py --scene column_collapse_3d_slab --steps 5e-3 # the 3D slabs (an hour)
 
@@ -66,7 +66,7 @@ def setting_text(setting):
         "set %s = %s\n" % (name, value.strip()) + "end\n" * len(sections)
 
 
-def scene_text(scene, kind, rolling, step, threshold, settings):
+def scene_text(scene, kind, rolling, step, settings):
     """The ready scene's text with the packings' paths made absolute and
     the study's settings appended (a later 'set' overrides an earlier)."""
     text = ready_scene_text("%s_%s" % (scene, kind))
@@ -74,17 +74,12 @@ def scene_text(scene, kind, rolling, step, threshold, settings):
     if rolling is not None:
         text += "subsection Contacts\n  set Rolling friction = %s\nend\n" \
             % rolling
-    if threshold is not None:
-        text += "subsection Coupling\n  set Resting threshold = %s\nend\n" \
-            % threshold
     return text + "".join(setting_text(s) for s in settings)
 
 
-def case_name(rolling, step, threshold, settings):
+def case_name(rolling, step, settings):
     name = "rolling_%s_dt_%s" % ("scene" if rolling is None else rolling,
                                  step)
-    if threshold is not None:
-        name += "_threshold_%s" % threshold
     for setting in settings:
         name += "_" + re.sub(r"[^A-Za-z0-9.=-]", "-", setting)
     return name
@@ -106,7 +101,6 @@ def main():
     parser.add_argument("--steps", default=DEFAULT_STEPS,
                         help="time steps, comma separated (default: %s)"
                         % DEFAULT_STEPS)
-    parser.add_argument("--threshold", help="Coupling/Resting threshold")
     parser.add_argument("--set", action="append", default=[],
                         metavar="SECTION/NAME=VALUE",
                         help="any other parameter (repeatable)")
@@ -131,12 +125,9 @@ def main():
     cases = []
     for rolling in rollings:
         for step in steps:
-            folder = os.path.join(results, case_name(rolling, step,
-                                                     args.threshold,
-                                                     args.set))
+            folder = os.path.join(results, case_name(rolling, step, args.set))
             for kind in ("loose", "dense"):
-                text = scene_text(args.scene, kind, rolling, step,
-                                  args.threshold, args.set)
+                text = scene_text(args.scene, kind, rolling, step, args.set)
                 cases.append((rolling, step, kind,
                               os.path.join(folder, kind), text))
 
@@ -215,10 +206,8 @@ def main():
           "the loose run-out." % EXPERIMENT_RATIO)
 
     if args.figure:
-        folders = [(os.path.join(results, case_name(r, s, args.threshold,
-                                                   args.set), "loose"),
-                    os.path.join(results, case_name(r, s, args.threshold,
-                                                   args.set), "dense"))
+        folders = [(os.path.join(results, case_name(r, s, args.set), "loose"),
+                    os.path.join(results, case_name(r, s, args.set), "dense"))
                    for r in rollings for s in steps
                    if (r, s, "loose") in measured and
                    (r, s, "dense") in measured]
