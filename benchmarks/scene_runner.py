@@ -7,6 +7,10 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
+class RunFailed(RuntimeError):
+    """A run that stopped with an error (which it printed itself)."""
+
+
 def read_csv(path):
     with open(path) as f:
         return list(csv.DictReader(f))
@@ -29,9 +33,13 @@ def run_scene(prm_text, directory, ranks=1):
                OMPI_MCA_rmaps_base_oversubscribe="1",
                DEAL_II_NUM_THREADS="1", OMP_NUM_THREADS="1")
     try:
-        subprocess.run(command, check=True, env=env)
+        code = subprocess.run(command, env=env).returncode
     finally:
         os.unlink(prm.name)
+    if code != 0:
+        # The executable has said why in one line above.
+        raise RunFailed("the run into %s stopped with exit code %d"
+                        % (directory, code))
     return read_csv(os.path.join(directory, "statistics.csv"))
 
 

@@ -33,7 +33,8 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.dirname(HERE))
 from plot_avalanche import analyse  # noqa: E402
-from scene_runner import finished, ready_scene_text, run_scene  # noqa: E402
+from scene_runner import (RunFailed, finished, ready_scene_text,  # noqa: E402
+                          run_scene)
 
 G = 9.81
 
@@ -126,4 +127,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except RunFailed as error:
+        sys.exit("run.py: %s" % error)

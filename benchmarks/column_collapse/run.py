@@ -8,7 +8,7 @@ stops at about half the loose run-out".
 
     /usr/bin/python3 benchmarks/column_collapse/run.py [--rolling 0.2,0.3]
         [--steps 5e-3,4.8e-3] [--set Contacts/Friction=0.8]
-        [--scene column_collapse_2d]
+        [--scene column_collapse_2d] [--loose-packing-set NAME=VALUE]
         [--jobs 2] [--ranks 1] [--analyse-only] [--figure collapse.png]
 
 A collapse is chaotic: a time step 1-4 % off ends at run-outs up to a fifth
@@ -26,6 +26,14 @@ scenes' own rolling friction is kept. The studies of the page:
     run.py --steps 1e-3 --set "Coupling/Resting threshold=0.01"
     run.py --rolling 0 --set Contacts/Friction=0.8 --steps 4.9e-3,5e-3,5.1e-3
     run.py --scene column_collapse_3d_slab --steps 5e-3 # the 3D slabs (an hour)
+    run.py --scene column_collapse_3d_slab --steps 5e-3 \
+        --loose-packing-set "Contacts/Rolling friction=0.15" # a looser slab
+
+--loose-packing-set prepares the loose column anew: it runs
+prm/packings/<scene>_loose.prm with the settings given (rolling friction
+while the grains settle packs them looser) into
+benchmarks/results/column_collapse/<scene>/packings/, and the loose
+column starts from the grains that run leaves.
 
 Each run writes into benchmarks/results/column_collapse/<scene>/<case>/
 {loose,dense}; a run whose statistics reach the scene's end time is not
@@ -47,7 +55,8 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 sys.path.insert(0, os.path.dirname(HERE))
 from plot_column_collapse import measure  # noqa: E402
-from scene_runner import finished, ready_scene_text, run_scene  # noqa: E402
+from scene_runner import (RunFailed, finished, ready_scene_text,  # noqa: E402
+                          run_scene)
 
 # The scene's step and five 1-4 % off it (doc/scenes/column_collapse_2d.md).
 DEFAULT_STEPS = "5e-3,4.8e-3,4.9e-3,4.95e-3,5.05e-3,5.1e-3"
@@ -77,12 +86,31 @@ def scene_text(scene, kind, rolling, step, settings):
     return text + "".join(setting_text(s) for s in settings)
 
 
-def case_name(rolling, step, settings):
+def settings_name(settings):
+    return "".join("_" + re.sub(r"[^A-Za-z0-9.=-]", "-", setting)
+                   for setting in settings)
+
+
+def case_name(rolling, step, settings, packing_settings=()):
     name = "rolling_%s_dt_%s" % ("scene" if rolling is None else rolling,
-                                 step)
-    for setting in settings:
-        name += "_" + re.sub(r"[^A-Za-z0-9.=-]", "-", setting)
+                                 step) + settings_name(settings)
+    if packing_settings:
+        name += "_loose-packing" + settings_name(packing_settings)
     return name
+
+
+def prepare_loose_packing(scene, settings, results, ranks):
+    """Runs the loose packing's preparation with @p settings (once) and
+    returns the grain file it leaves."""
+    text = ready_scene_text(os.path.join("packings", scene + "_loose")) + \
+        "".join(setting_text(s) for s in settings)
+    directory = os.path.join(results, "packings",
+                             "loose" + settings_name(settings))
+    if not finished(directory, text):
+        print("preparing the loose packing: %s"
+              % os.path.relpath(directory, ROOT), flush=True)
+        run_scene(text, directory, ranks)
+    return os.path.join(directory, "grains.txt")
 
 
 def spread(values, form):
@@ -106,6 +134,11 @@ def main():
                         help="any other parameter (repeatable)")
     parser.add_argument("--scene", default="column_collapse_2d",
                         help="prm/<scene>_{loose,dense}.prm")
+    parser.add_argument("--loose-packing-set", action="append", default=[],
+                        metavar="SECTION/NAME=VALUE",
+                        help="prepare the loose column anew, with this "
+                        "parameter of its packing's preparation changed "
+                        "(repeatable)")
     parser.add_argument("--jobs", type=int, default=2,
                         help="runs side by side")
     parser.add_argument("--ranks", type=int, default=1,
@@ -122,12 +155,29 @@ def main():
     results = os.path.join(ROOT, "benchmarks", "results", "column_collapse",
                            args.scene)
 
+    loose_settings = []
+    if args.loose_packing_set:
+        if args.analyse_only:
+            grains = os.path.join(
+                results, "packings",
+                "loose" + settings_name(args.loose_packing_set), "grains.txt")
+        else:
+            grains = prepare_loose_packing(args.scene, args.loose_packing_set,
+                                           results, args.ranks)
+        loose_settings = ["Grains/Placement/File=" + grains]
+
+    def folder_of(rolling, step):
+        return os.path.join(results, case_name(rolling, step, args.set,
+                                               args.loose_packing_set))
+
     cases = []
     for rolling in rollings:
         for step in steps:
-            folder = os.path.join(results, case_name(rolling, step, args.set))
+            folder = folder_of(rolling, step)
             for kind in ("loose", "dense"):
-                text = scene_text(args.scene, kind, rolling, step, args.set)
+                text = scene_text(args.scene, kind, rolling, step,
+                                  args.set + (loose_settings
+                                              if kind == "loose" else []))
                 cases.append((rolling, step, kind,
                               os.path.join(folder, kind), text))
 
@@ -206,8 +256,8 @@ def main():
           "the loose run-out." % EXPERIMENT_RATIO)
 
     if args.figure:
-        folders = [(os.path.join(results, case_name(r, s, args.set), "loose"),
-                    os.path.join(results, case_name(r, s, args.set), "dense"))
+        folders = [(os.path.join(folder_of(r, s), "loose"),
+                    os.path.join(folder_of(r, s), "dense"))
                    for r in rollings for s in steps
                    if (r, s, "loose") in measured and
                    (r, s, "dense") in measured]
@@ -223,4 +273,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except RunFailed as error:
+        sys.exit("run.py: %s" % error)
