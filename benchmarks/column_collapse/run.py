@@ -99,13 +99,16 @@ def case_name(rolling, step, settings, packing_settings=()):
     return name
 
 
+def loose_packing_directory(results, settings):
+    return os.path.join(results, "packings", "loose" + settings_name(settings))
+
+
 def prepare_loose_packing(scene, settings, results, ranks):
     """Runs the loose packing's preparation with @p settings (once) and
     returns the grain file it leaves."""
     text = ready_scene_text(os.path.join("packings", scene + "_loose")) + \
         "".join(setting_text(s) for s in settings)
-    directory = os.path.join(results, "packings",
-                             "loose" + settings_name(settings))
+    directory = loose_packing_directory(results, settings)
     if not finished(directory, text):
         print("preparing the loose packing: %s"
               % os.path.relpath(directory, ROOT), flush=True)
@@ -159,8 +162,8 @@ def main():
     if args.loose_packing_set:
         if args.analyse_only:
             grains = os.path.join(
-                results, "packings",
-                "loose" + settings_name(args.loose_packing_set), "grains.txt")
+                loose_packing_directory(results, args.loose_packing_set),
+                "grains.txt")
         else:
             grains = prepare_loose_packing(args.scene, args.loose_packing_set,
                                            results, args.ranks)
